@@ -1,0 +1,86 @@
+// include/fesd/integrator.hpp: FESD integrator with exact switch detection, eq. (32) of
+// papers/fesd-filippov.txt, and the standard time-stepping method (26) for comparison.
+//
+// [0, T_sim] is split into N_sim steps of length T_sim / N_sim. Each step is one FESD problem with
+// N_FE finite elements whose lengths h_n are free (sum h_n = T), solved as an MPCC by a homotopy of
+// NLPs (IPOPT, exact sparse derivatives). The next step starts where the last ended.
+#pragma once
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "fesd/model.hpp"
+#include "fesd/options.hpp"
+#include "fesd/status.hpp"
+
+namespace fesd {
+
+/// One NLP of a homotopy (one row of the progress table).
+struct HomotopyRow {
+  int k = 0;                   ///< homotopy iteration
+  double sigma = 0;            ///< relaxation parameter
+  double comp_residual = 0;    ///< largest complementarity product after the solve
+  double objective = 0;
+  double inf_pr = 0;           ///< IPOPT's final primal infeasibility
+  int nlp_iterations = 0;
+  std::string nlp_status;      ///< IPOPT's return status, e.g. "Solve_Succeeded"
+  double cpu_s = 0;
+};
+
+/// A detected switch: the active set changes at an element boundary.
+struct SwitchEvent {
+  double t = 0;               ///< switching time t_s = boundary between the two elements
+  int element = 0;            ///< global index of the element that ends at t
+  std::vector<int> before;    ///< active regions (global region indices) before t
+  std::vector<int> after;     ///< active regions after t
+};
+
+/// Work and time of a whole run.
+struct Summary {
+  int homotopy_steps = 0;      ///< NLPs solved
+  int nlp_iterations = 0;      ///< IPOPT iterations, all NLPs
+  double wall_s = 0;           ///< total wall time
+  double derivative_s = 0;     ///< time in fesd's function and derivative evaluations
+  double solver_s = 0;         ///< time inside IPOPT (incl. MUMPS), excluding the evaluations
+  double setup_s = 0;          ///< building the NLP (patterns, index maps)
+  double max_comp_residual = 0;  ///< largest final complementarity residual over the steps
+};
+
+/// The result of integrate(). Time grid = all finite-element boundaries t_0 < ... < t_{N_sim N_FE}.
+struct IntegratorResult {
+  Status status = Status::NotRun;
+  std::string message = "integrate() was not called";
+
+  std::vector<double> t;                 ///< element boundaries, size N_sim * N_FE + 1
+  std::vector<Eigen::VectorXd> x;        ///< x_n at t_n
+  std::vector<double> h;                 ///< h_n, size N_sim * N_FE
+
+  /// Stage points t_n + c_m h_n and the stage values there (size N_sim * N_FE * n_s each).
+  std::vector<double> t_stage;
+  std::vector<Eigen::VectorXd> x_stage, theta, lambda, mu;
+
+  /// Active regions per element (global region indices, sorted), size N_sim * N_FE.
+  std::vector<std::vector<int>> active_set;
+  std::vector<SwitchEvent> switches;
+
+  /// One homotopy per integration step.
+  std::vector<std::vector<HomotopyRow>> homotopy;
+  Summary summary;
+
+  Eigen::VectorXd x_final() const { return x.empty() ? Eigen::VectorXd() : x.back(); }
+  std::vector<double> switch_times() const;
+  /// One line: status, final state, number of switches, time.
+  std::string brief_report() const;
+  /// Several lines: the switches, statistics and timing split.
+  std::string full_report() const;
+};
+
+/// Simulates the PSS from x0 over [0, T_sim] with N_sim steps. p: parameter values (empty: the
+/// model's defaults); u: constant controls (empty: zero). Bad input (sizes, NaN, options) throws
+/// fesd::Error before any computation; numerical failure is reported in the result's status.
+IntegratorResult integrate(const Pss& model, const Eigen::VectorXd& x0, double T_sim, int N_sim,
+                           const IntegratorOptions& options = {},
+                           const Eigen::VectorXd& u = {}, const Eigen::VectorXd& p = {});
+
+}  // namespace fesd

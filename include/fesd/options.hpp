@@ -1,0 +1,91 @@
+// include/fesd/options.hpp: discretization, homotopy and NLP options. Plain structs with documented
+// defaults; validate() lists every broken rule. Problem-file keys (nosnoc's names where nosnoc has
+// one) are given beside each field; docs/options.md is the full table.
+#pragma once
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "fesd/tableau.hpp"
+
+namespace fesd {
+
+/// Which form of cross complementarity (Sect. 3.2.2) enters the MPCC. All forms are equivalent at
+/// an exact solution; they differ in how many constraints the relaxed NLPs have.
+enum class CrossComp {
+  /// (28): theta_{n,m,i} lambda_{n,m',i} = 0 for every stage m, every point m' != m, every i.
+  Sparse,
+  /// theta_{n,m,i} * sum_{m'} lambda_{n,m',i} = 0 for every stage m and i (nosnoc_py's default).
+  StageSum,
+  /// One constraint per finite element: the sum of all (28) products of that element.
+  Element,
+  /// (29): one constraint per pair of neighbouring finite elements.
+  Neighbor,
+};
+/// Problem-file key `cross_comp_mode`: "sparse", "stage_sum", "element", "neighbor".
+std::string_view to_string(CrossComp v);
+bool parse(std::string_view name, CrossComp& out);
+
+/// Step equilibration (Sect. 3.2.3): how the spurious degrees of freedom of h_n are removed.
+enum class StepEq {
+  None,           ///< h_n free within its bounds
+  Eta,            ///< (31): (h_n - h_{n-1}) eta_n = 0
+  EtaTanh,        ///< (31) with tanh(eta_n), better scaled
+  HeuristicMean,  ///< penalty rho_h * sum_n (h_n - T / N_FE)^2 in the objective (nosnoc's default)
+};
+/// Problem-file key `step_equilibration`: "none", "eta", "eta_tanh", "heuristic_mean".
+std::string_view to_string(StepEq v);
+bool parse(std::string_view name, StepEq& out);
+
+/// Discretization of one interval [0, T] (problem-file table [discretization]).
+struct DiscretizationOptions {
+  RkScheme rk_scheme = RkScheme::RadauIIA;  ///< `rk_scheme`
+  int n_s = 2;                              ///< `n_s`: RK stages, >= 1 (Lobatto >= 2, explicit <= 4)
+  int N_FE = 2;        ///< `N_finite_elements`: finite elements per step, >= 1 (>= 2 for FESD)
+  bool use_fesd = true;                     ///< `use_fesd`: false = standard time-stepping (26)
+  CrossComp cross_comp = CrossComp::StageSum;     ///< `cross_comp_mode`
+  StepEq step_eq = StepEq::HeuristicMean;         ///< `step_equilibration`
+  double gamma_h = 1.0;  ///< `gamma_h` in (0, 1]: h_n in [(1 - gamma_h) h0, (1 + gamma_h) h0] (59f)
+  double rho_h = 1.0;    ///< `rho_h` > 0: weight of the heuristic_mean penalty
+};
+
+/// The MPCC homotopy: a sequence of relaxed NLPs with theta_i lambda_i <= sigma (Scholtes),
+/// sigma_{k+1} = homotopy_update_slope * sigma_k, until the complementarity residual (the largest
+/// product of a complementarity pair, cross-complementarity pairs included) is <= complementarity_tol.
+struct HomotopyOptions {
+  double sigma_0 = 1.0;                ///< `sigma_0` > 0: first relaxation
+  double homotopy_update_slope = 0.1;  ///< `homotopy_update_slope` in (0, 1)
+  double sigma_N = 1e-12;              ///< `sigma_N` > 0: smallest sigma used
+  double complementarity_tol = 1e-9;   ///< `complementarity_tol` > 0: stop when residual <= this
+  int max_homotopy_steps = 20;         ///< `N_homotopy` >= 1: maximum number of NLPs per solve
+};
+
+/// IPOPT options (problem-file table [ipopt]). Any other IPOPT option can be passed by name.
+struct NlpOptions {
+  double tol = 1e-12;            ///< `tol` > 0 (IPOPT's default 1e-8 cannot reach 1e-12 accuracy)
+  double acceptable_tol = 1e-6;  ///< `acceptable_tol` > 0
+  int max_iter = 500;            ///< `max_iter` >= 1, per NLP
+  int print_level = 0;           ///< `print_level` 0..12 (IPOPT's own output)
+  /// Extra IPOPT options as (name, value) strings, e.g. {"mu_strategy", "monotone"}.
+  std::vector<std::pair<std::string, std::string>> extra;
+};
+
+/// Everything the FESD integrator needs besides the model.
+struct IntegratorOptions {
+  DiscretizationOptions discretization;
+  HomotopyOptions homotopy;
+  NlpOptions nlp;
+  /// Print one progress line per integration step to stderr (the CLI turns it on).
+  bool progress = false;
+};
+
+/// Empty if valid, else one line per broken rule: "discretization.n_s = 0: must be >= 1".
+std::vector<std::string> validate(const DiscretizationOptions& o);
+std::vector<std::string> validate(const HomotopyOptions& o);
+std::vector<std::string> validate(const NlpOptions& o);
+std::vector<std::string> validate(const IntegratorOptions& o);
+/// Throws fesd::InvalidOption with all messages of validate() if any.
+void check(const IntegratorOptions& o);
+
+}  // namespace fesd

@@ -1,0 +1,414 @@
+#include "discretization/fesd_interval.hpp"
+
+#include <cmath>
+#include <limits>
+#include <unordered_map>
+
+#include "fesd/error.hpp"
+
+namespace fesd::discretization {
+namespace {
+
+using nlp::kInf;
+using nlp::make_block;
+
+/// Builds a block's variable list: distinct NLP indices, each with its local position.
+class VarList {
+ public:
+  int add(int global) {
+    auto [it, fresh] = local_.emplace(global, static_cast<int>(vars_.size()));
+    if (fresh) vars_.push_back(global);
+    return it->second;
+  }
+  std::vector<int> add(const std::vector<int>& globals) {
+    std::vector<int> r;
+    for (int g : globals) r.push_back(add(g));
+    return r;
+  }
+  const std::vector<int>& vars() const { return vars_; }
+
+ private:
+  std::unordered_map<int, int> local_;
+  std::vector<int> vars_;
+};
+
+std::vector<int> range(int first, int n) {
+  std::vector<int> r(n);
+  for (int i = 0; i < n; ++i) r[i] = first + i;
+  return r;
+}
+
+// ---- the equations as functors on local inputs w ------------------------------------------
+
+/// X - x - h sum_j a_j V_j = 0 for one state component.  inputs: X, x, h, V_j (j with a_j != 0)
+struct StageStateEq {
+  std::vector<double> a;
+  int num_inputs() const { return 3 + static_cast<int>(a.size()); }
+  int num_outputs() const { return 1; }
+  template <class T>
+  void operator()(const T* w, T* c) const {
+    T s(0.0);
+    for (std::size_t j = 0; j < a.size(); ++j) s = s + a[j] * w[3 + j];
+    c[0] = w[0] - w[1] - w[2] * s;
+  }
+};
+
+/// V - sum_r f_r(X, q, p) theta_r = 0.  inputs: V (n_x), X (n_x), theta (n_theta), q, p
+struct DynamicsEq {
+  const Pss* m;
+  int num_inputs() const { return 2 * m->n_x() + m->n_theta() + m->n_u() + m->n_p(); }
+  int num_outputs() const { return m->n_x(); }
+  template <class T>
+  void operator()(const T* w, T* c) const {
+    const int n_x = m->n_x();
+    const T* V = w;
+    const T* X = w + n_x;
+    const T* theta = X + n_x;
+    const T* q = theta + m->n_theta();
+    const T* p = q + m->n_u();
+    dcs::eval_F_theta(*m, X, q, p, theta, c);
+    for (int i = 0; i < n_x; ++i) c[i] = V[i] - c[i];
+  }
+};
+
+/// g(X) - lambda - mu_{k(r)} = 0.  inputs: X (n_x), lambda (n_theta), mu (n_sys), p
+struct LpEq {
+  const Pss* m;
+  std::vector<int> owner;  // subsystem of each region
+  int num_inputs() const { return m->n_x() + m->n_theta() + m->n_sys() + m->n_p(); }
+  int num_outputs() const { return m->n_theta(); }
+  template <class T>
+  void operator()(const T* w, T* c) const {
+    const T* X = w;
+    const T* lambda = X + m->n_x();
+    const T* mu = lambda + m->n_theta();
+    const T* p = mu + m->n_sys();
+    dcs::eval_g(*m, X, p, c);
+    for (int r = 0; r < m->n_theta(); ++r) c[r] = c[r] - lambda[r] - mu[owner[r]];
+  }
+};
+
+/// e' theta^k = 1 per subsystem.  inputs: theta (n_theta)
+struct SimplexEq {
+  std::vector<int> offsets;  // region_offset(0..n_sys)
+  int num_inputs() const { return offsets.back(); }
+  int num_outputs() const { return static_cast<int>(offsets.size()) - 1; }
+  template <class T>
+  void operator()(const T* w, T* c) const {
+    for (int k = 0; k + 1 < static_cast<int>(offsets.size()); ++k) {
+      T s(0.0);
+      for (int r = offsets[k]; r < offsets[k + 1]; ++r) s = s + w[r];
+      c[k] = s;
+    }
+  }
+};
+
+/// sum of the inputs (sum h_n = T).
+struct SumEq {
+  int n;
+  int num_inputs() const { return n; }
+  int num_outputs() const { return 1; }
+  template <class T>
+  void operator()(const T* w, T* c) const {
+    T s(0.0);
+    for (int i = 0; i < n; ++i) s = s + w[i];
+    c[0] = s;
+  }
+};
+
+/// (h - h0)^2, the heuristic_mean penalty term.
+struct SquaredDeviation {
+  double h0;
+  int num_inputs() const { return 1; }
+  int num_outputs() const { return 1; }
+  template <class T>
+  void operator()(const T* w, T* c) const {
+    const T d = w[0] - h0;
+    c[0] = d * d;
+  }
+};
+
+/// Step equilibration (31): (h_n - h_{n-1}) * eta_n (or tanh(eta_n)), with
+///   eta_n = prod_r ( sigma^{lambda,B}_r sigma^{lambda,F}_r + sigma^{theta,B}_r sigma^{theta,F}_r ).
+/// Index lists are local positions of the summed lambdas/thetas per region r.
+struct StepEquilibrationEq {
+  int k = 0;
+  int h_prev = 0, h_cur = 1;
+  std::vector<std::vector<int>> lam_B, lam_F, th_B, th_F;  // per region
+  bool use_tanh = false;
+  int num_inputs() const { return k; }
+  int num_outputs() const { return 1; }
+  template <class T>
+  static T sum(const T* w, const std::vector<int>& idx) {
+    T s(0.0);
+    for (int i : idx) s = s + w[i];
+    return s;
+  }
+  template <class T>
+  T eta(const T* w) const {
+    T e(1.0);
+    for (std::size_t r = 0; r < lam_B.size(); ++r)
+      e = e * (sum(w, lam_B[r]) * sum(w, lam_F[r]) + sum(w, th_B[r]) * sum(w, th_F[r]));
+    return e;
+  }
+  template <class T>
+  void operator()(const T* w, T* c) const {
+    using std::tanh;
+    const T e = eta(w);
+    c[0] = (w[h_cur] - w[h_prev]) * (use_tanh ? tanh(e) : e);
+  }
+};
+
+}  // namespace
+
+FesdInterval::FesdInterval(const Pss& model, const Tableau& tableau,
+                           const DiscretizationOptions& options)
+    : model_(model), tab_(tableau), opt_(options), N_FE_(options.N_FE), n_s_(tableau.n_s) {
+  stiffly_accurate_ = tab_.stiffly_accurate;
+}
+
+void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
+  in_ = in;
+  const Pss& m = model_;
+  const int n_x = m.n_x(), n_th = m.n_theta(), n_sys = m.n_sys();
+  if (static_cast<int>(in.s0.size()) != n_x || static_cast<int>(in.q.size()) != m.n_u() ||
+      static_cast<int>(in.p.size()) != m.n_p() || static_cast<int>(in.lambda_start.size()) != n_th ||
+      static_cast<int>(in.mu_start.size()) != n_sys)
+    throw Error("internal: FesdInterval inputs do not match the model dimensions");
+  const bool fesd = opt_.use_fesd;
+  const double h0 = in.T / N_FE_;
+
+  // ---- variables ----
+  h_.assign(N_FE_, -1);
+  V_.assign(N_FE_ * n_s_, -1);
+  X_.assign(N_FE_ * n_s_, -1);
+  theta_.assign(N_FE_ * n_s_, -1);
+  lambda_.assign(N_FE_ * n_s_, -1);
+  mu_.assign(N_FE_ * n_s_, -1);
+  x_.assign(N_FE_ + 1, {});
+  x_[0] = in.s0;
+  lambda_end_.assign(N_FE_, {});
+  mu_end_.assign(N_FE_, {});
+  for (int n = 0; n < N_FE_; ++n) {
+    const double h_lb = fesd ? (1.0 - opt_.gamma_h) * h0 : h0;
+    const double h_ub = fesd ? (1.0 + opt_.gamma_h) * h0 : h0;
+    h_[n] = nlp.add_variables(1, h_lb, h_ub, h0);
+    for (int s = 0; s < n_s_; ++s) {
+      V_[idx(n, s)] = nlp.add_variables(n_x, -kInf, kInf, 0.0);
+      X_[idx(n, s)] = nlp.add_variables(n_x, -kInf, kInf, 0.0);
+      theta_[idx(n, s)] = nlp.add_variables(n_th, 0.0, kInf, 0.0);
+      lambda_[idx(n, s)] = nlp.add_variables(n_th, 0.0, kInf, 0.0);
+      mu_[idx(n, s)] = nlp.add_variables(n_sys, -kInf, kInf, 0.0);
+    }
+    if (stiffly_accurate_) {
+      x_[n + 1] = range(X_[idx(n, n_s_ - 1)], n_x);  // x_{n+1} = X_{n,n_s}: last row of A is b
+      lambda_end_[n] = range(lambda_[idx(n, n_s_ - 1)], n_th);
+      mu_end_[n] = range(mu_[idx(n, n_s_ - 1)], n_sys);
+    } else {
+      x_[n + 1] = range(nlp.add_variables(n_x, -kInf, kInf, 0.0), n_x);
+      const bool boundary = fesd && (n < N_FE_ - 1 || in.boundary_at_end);
+      if (boundary) {  // (33): lambda, mu at t_{n+1} from LP(x_{n+1}); theta discarded (39)
+        lambda_end_[n] = range(nlp.add_variables(n_th, 0.0, kInf, 0.0), n_th);
+        mu_end_[n] = range(nlp.add_variables(n_sys, -kInf, kInf, 0.0), n_sys);
+      }
+    }
+  }
+
+  // ---- shared blocks ----
+  const auto owner = dcs::region_subsystem(m);
+  std::vector<int> offsets;
+  for (int k = 0; k <= n_sys; ++k) offsets.push_back(m.region_offset(k));
+  auto dynamics = make_block(DynamicsEq{&m});
+  auto lp = make_block(LpEq{&m, owner});
+  auto simplex = make_block(SimplexEq{offsets});
+  std::vector<std::shared_ptr<const nlp::Block>> stage_state(n_s_);
+  std::vector<std::vector<int>> stage_cols(n_s_);
+  for (int s = 0; s < n_s_; ++s) {
+    std::vector<double> a;
+    for (int j = 0; j < n_s_; ++j)
+      if (tab_.A(s, j) != 0.0) {
+        a.push_back(tab_.A(s, j));
+        stage_cols[s].push_back(j);
+      }
+    stage_state[s] = make_block(StageStateEq{a});
+  }
+  std::vector<double> b;
+  std::vector<int> b_cols;
+  for (int j = 0; j < n_s_; ++j)
+    if (tab_.b(j) != 0.0) {
+      b.push_back(tab_.b(j));
+      b_cols.push_back(j);
+    }
+  auto continuity = make_block(StageStateEq{b});
+
+  for (int n = 0; n < N_FE_; ++n) {
+    for (int s = 0; s < n_s_; ++s) {
+      for (int i = 0; i < n_x; ++i) {  // X_{n,s} = x_n + h_n sum_j a_sj V_{n,j}
+        std::vector<int> vars{X(n, s, i), x(n, i), h(n)};
+        for (int j : stage_cols[s]) vars.push_back(V(n, j, i));
+        nlp.add_constraint(stage_state[s], vars, 0.0, 0.0);
+      }
+      std::vector<int> dv = range(V(n, s, 0), n_x);  // (25): V = F(X) theta
+      for (int i = 0; i < n_x; ++i) dv.push_back(X(n, s, i));
+      for (int r = 0; r < n_th; ++r) dv.push_back(theta(n, s, r));
+      dv.insert(dv.end(), in.q.begin(), in.q.end());
+      dv.insert(dv.end(), in.p.begin(), in.p.end());
+      nlp.add_constraint(dynamics, dv, 0.0, 0.0);
+      std::vector<int> lv = range(X(n, s, 0), n_x);  // (9): g(X) - lambda - mu e = 0
+      for (int r = 0; r < n_th; ++r) lv.push_back(lambda(n, s, r));
+      for (int k = 0; k < n_sys; ++k) lv.push_back(mu(n, s, k));
+      lv.insert(lv.end(), in.p.begin(), in.p.end());
+      nlp.add_constraint(lp, lv, 0.0, 0.0);
+      nlp.add_constraint(simplex, range(theta(n, s, 0), n_th), 1.0, 1.0);  // e' theta = 1
+    }
+    if (!stiffly_accurate_) {
+      for (int i = 0; i < n_x; ++i) {  // x_{n+1} = x_n + h_n sum b_m V_{n,m}
+        std::vector<int> vars{x(n + 1, i), x(n, i), h(n)};
+        for (int j : b_cols) vars.push_back(V(n, j, i));
+        nlp.add_constraint(continuity, vars, 0.0, 0.0);
+      }
+      if (!lambda_end_[n].empty()) {  // (33) at x_{n+1}
+        std::vector<int> lv = x_[n + 1];
+        lv.insert(lv.end(), lambda_end_[n].begin(), lambda_end_[n].end());
+        lv.insert(lv.end(), mu_end_[n].begin(), mu_end_[n].end());
+        lv.insert(lv.end(), in.p.begin(), in.p.end());
+        nlp.add_constraint(lp, lv, 0.0, 0.0);
+      }
+    }
+  }
+
+  // ---- lambda points per element: start, stages, end boundary (27), (34) ----
+  points_.assign(N_FE_, {});
+  for (int n = 0; n < N_FE_; ++n) {
+    std::vector<int> start = n == 0 ? in.lambda_start : lambda_end_[n - 1];
+    if (!start.empty()) points_[n].push_back(start);
+    for (int s = 0; s < n_s_; ++s) points_[n].push_back(range(lambda(n, s, 0), n_th));
+    if (!stiffly_accurate_ && !lambda_end_[n].empty()) points_[n].push_back(lambda_end_[n]);
+  }
+
+  step_eq_rows_.clear();
+  if (fesd) {
+    nlp.add_constraint(make_block(SumEq{N_FE_}), h_, in.T, in.T);  // sum h_n = T
+    if (opt_.step_eq == StepEq::Eta || opt_.step_eq == StepEq::EtaTanh) {
+      for (int n = 1; n < N_FE_; ++n) {  // (31)
+        VarList vl;
+        StepEquilibrationEq f;
+        f.use_tanh = opt_.step_eq == StepEq::EtaTanh;
+        f.h_prev = vl.add(h(n - 1));
+        f.h_cur = vl.add(h(n));
+        f.lam_B.assign(n_th, {});
+        f.lam_F.assign(n_th, {});
+        f.th_B.assign(n_th, {});
+        f.th_F.assign(n_th, {});
+        for (int r = 0; r < n_th; ++r) {
+          for (const auto& pt : points_[n - 1]) f.lam_B[r].push_back(vl.add(pt[r]));
+          for (const auto& pt : points_[n]) f.lam_F[r].push_back(vl.add(pt[r]));
+          for (int s = 0; s < n_s_; ++s) {
+            f.th_B[r].push_back(vl.add(theta(n - 1, s, r)));
+            f.th_F[r].push_back(vl.add(theta(n, s, r)));
+          }
+        }
+        f.k = static_cast<int>(vl.vars().size());
+        step_eq_rows_.push_back(nlp.add_constraint(make_block(f), vl.vars(), 0.0, 0.0));
+      }
+    } else if (opt_.step_eq == StepEq::HeuristicMean) {
+      auto pen = make_block(SquaredDeviation{h0});
+      for (int n = 0; n < N_FE_; ++n) nlp.add_objective(pen, {h(n)}, opt_.rho_h);
+    }
+  }
+  build_complementarity();
+}
+
+void FesdInterval::build_complementarity() {
+  const int n_th = model_.n_theta();
+  residual_pairs_.clear();
+  groups_.clear();
+  const bool fesd = opt_.use_fesd;
+  // Position of stage s among the points of element n (the start point shifts stages by one).
+  auto stage_point = [&](int n, int s) {
+    return (n == 0 ? !in_.lambda_start.empty() : !lambda_end_[n - 1].empty()) ? s + 1 : s;
+  };
+  std::vector<std::vector<CompPair>> cross_by_element;
+  for (int n = 0; n < N_FE_; ++n) {
+    CompGroup element;
+    std::vector<CompPair> cross;  // pairs with m' != m
+    const auto& pts = points_[n];
+    for (int s = 0; s < n_s_; ++s) {
+      const int own = stage_point(n, s);
+      for (int r = 0; r < n_th; ++r) {
+        CompGroup stage_sum;
+        for (int q = 0; q < static_cast<int>(pts.size()); ++q) {
+          if (!fesd && q != own) continue;  // standard method: no cross complementarity
+          const CompPair pair{theta(n, s, r), pts[q][r]};
+          residual_pairs_.push_back(pair);
+          stage_sum.pairs.push_back(pair);
+          element.pairs.push_back(pair);
+          if (q != own) cross.push_back(pair);
+          if (!fesd || opt_.cross_comp == CrossComp::Sparse ||
+              (opt_.cross_comp == CrossComp::Neighbor && q == own))
+            groups_.push_back({{pair}});
+        }
+        if (fesd && opt_.cross_comp == CrossComp::StageSum) groups_.push_back(std::move(stage_sum));
+      }
+    }
+    if (fesd && opt_.cross_comp == CrossComp::Element) groups_.push_back(std::move(element));
+    cross_by_element.push_back(std::move(cross));
+  }
+  if (fesd && opt_.cross_comp == CrossComp::Neighbor) {  // (29): elements n and n+1 together
+    for (int n = 0; n + 1 < N_FE_ || n == 0; ++n) {
+      CompGroup g{cross_by_element[n]};
+      if (n + 1 < N_FE_)
+        g.pairs.insert(g.pairs.end(), cross_by_element[n + 1].begin(), cross_by_element[n + 1].end());
+      groups_.push_back(std::move(g));
+    }
+  }
+}
+
+void FesdInterval::set_guess(nlp::BlockNlp& nlp, const Eigen::VectorXd& x0,
+                             const dcs::LpSolution& lp, const Eigen::VectorXd& xdot) const {
+  const int n_x = model_.n_x(), n_th = model_.n_theta(), n_sys = model_.n_sys();
+  const double h0 = in_.T / N_FE_;
+  auto& w = nlp.x_init;
+  for (int n = 0; n <= N_FE_; ++n)
+    for (int i = 0; i < n_x; ++i) w[x(n, i)] = x0[i] + n * h0 * xdot[i];
+  for (int n = 0; n < N_FE_; ++n) {
+    w[h(n)] = h0;
+    for (int s = 0; s < n_s_; ++s) {
+      for (int i = 0; i < n_x; ++i) {
+        w[V(n, s, i)] = xdot[i];
+        w[X(n, s, i)] = x0[i] + (n + tab_.c(s)) * h0 * xdot[i];
+      }
+      for (int r = 0; r < n_th; ++r) {
+        w[theta(n, s, r)] = lp.theta[r];
+        w[lambda(n, s, r)] = lp.lambda[r];
+      }
+      for (int k = 0; k < n_sys; ++k) w[mu(n, s, k)] = lp.mu[k];
+    }
+    if (!stiffly_accurate_ && !lambda_end_[n].empty()) {
+      for (int r = 0; r < n_th; ++r) w[lambda_end_[n][r]] = lp.lambda[r];
+      for (int k = 0; k < n_sys; ++k) w[mu_end_[n][k]] = lp.mu[k];
+    }
+  }
+}
+
+std::vector<double> FesdInterval::eta(const double* w) const {
+  const int n_th = model_.n_theta();
+  std::vector<double> out(N_FE_, std::numeric_limits<double>::quiet_NaN());
+  for (int n = 1; n < N_FE_; ++n) {
+    double e = 1.0;
+    for (int r = 0; r < n_th; ++r) {
+      double lb = 0, lf = 0, tb = 0, tf = 0;
+      for (const auto& pt : points_[n - 1]) lb += w[pt[r]];
+      for (const auto& pt : points_[n]) lf += w[pt[r]];
+      for (int s = 0; s < n_s_; ++s) {
+        tb += w[theta(n - 1, s, r)];
+        tf += w[theta(n, s, r)];
+      }
+      e *= lb * lf + tb * tf;
+    }
+    out[n] = e;
+  }
+  return out;
+}
+
+}  // namespace fesd::discretization

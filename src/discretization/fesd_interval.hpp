@@ -1,0 +1,107 @@
+// src/discretization/fesd_interval.hpp: the equations of one control interval [0, T] with N_FE
+// finite elements and an n_s-stage RK method, written into a BlockNlp:
+//
+//   standard discretization (25)-(26):  per element n and stage m (differential form, lifted)
+//     X_{n,m} = x_n + h_n sum_j a_{m,j} V_{n,j}                         stage states
+//     V_{n,m} = sum_r f_r(X_{n,m}, q, p) theta_{n,m,r}                  (8a)/(21a)
+//     g(X_{n,m}) - lambda_{n,m} - mu_{n,m} e = 0,  e' theta^k_{n,m} = 1   (9)/(21b,c)
+//     x_{n+1} = x_n + h_n sum_m b_m V_{n,m}     (stiffly accurate schemes: x_{n+1} is X_{n,n_s})
+//   FESD (32) adds: h_n free with sum h_n = T and bounds (59f); boundary values lambda, mu at
+//   t_{n+1} for schemes that are not stiffly accurate (33)-(34); cross complementarity (28)/(29);
+//   step equilibration (31).
+//
+// The complementarity pairs are returned, not imposed: the MPCC layer decides how to relax them.
+// Integrator and OCP both build their NLPs from this block; its layout (which variable is
+// theta_{n,m,r}, h_n, ...) stays reachable for active-set and sensitivity code.
+#pragma once
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "dcs/stewart.hpp"
+#include "fesd/model.hpp"
+#include "fesd/options.hpp"
+#include "fesd/tableau.hpp"
+#include "nlp/block_nlp.hpp"
+
+namespace fesd::discretization {
+
+/// One complementarity pair a * b with a = theta (variable index) and b = lambda (variable index).
+struct CompPair {
+  int a = -1, b = -1;
+};
+/// A complementarity constraint: sum of products of its pairs, >= 0 by the variable bounds, = 0 at
+/// a solution of the MPCC. The MPCC layer relaxes it (e.g. <= sigma).
+struct CompGroup {
+  std::vector<CompPair> pairs;
+};
+
+/// Where the interval's inputs live in the NLP (variables, possibly fixed by their bounds).
+struct IntervalInputs {
+  std::vector<int> s0;            ///< n_x: state at the interval start
+  std::vector<int> q;             ///< n_u: control of the interval
+  std::vector<int> p;             ///< n_p: parameters
+  std::vector<int> lambda_start;  ///< n_theta: lambda_{0,0} (continuity from before, or fixed)
+  std::vector<int> mu_start;      ///< n_sys: mu_{0,0}
+  double T = 0;                   ///< interval length
+  /// For schemes that are not stiffly accurate: add boundary values (33) at the interval end too
+  /// (needed when another interval follows).
+  bool boundary_at_end = false;
+};
+
+class FesdInterval {
+ public:
+  FesdInterval(const Pss& model, const Tableau& tableau, const DiscretizationOptions& options);
+
+  /// Adds variables and constraint/objective blocks to `nlp`.
+  void build(nlp::BlockNlp& nlp, const IntervalInputs& in);
+
+  /// Sets the initial guess of every variable of the interval: states on the explicit Euler
+  /// prediction from x0 with derivative xdot, algebraic variables from the LP solution.
+  void set_guess(nlp::BlockNlp& nlp, const Eigen::VectorXd& x0, const dcs::LpSolution& lp,
+                 const Eigen::VectorXd& xdot) const;
+
+  // ---- layout (valid after build); n: element, m: stage 0..n_s-1, i: state, r: region ----
+  int N_FE() const { return N_FE_; }
+  int n_s() const { return n_s_; }
+  int x(int n, int i) const { return x_[n][i]; }  ///< n = 0..N_FE (n = 0: s0)
+  int h(int n) const { return h_[n]; }
+  int V(int n, int m, int i) const { return V_[idx(n, m)] + i; }
+  int X(int n, int m, int i) const { return X_[idx(n, m)] + i; }
+  int theta(int n, int m, int r) const { return theta_[idx(n, m)] + r; }
+  int lambda(int n, int m, int r) const { return lambda_[idx(n, m)] + r; }
+  int mu(int n, int m, int k) const { return mu_[idx(n, m)] + k; }
+  /// lambda, mu at t_{n+1} (-1 where the scheme/options give none).
+  int lambda_end(int n, int r) const { return lambda_end_[n].empty() ? -1 : lambda_end_[n][r]; }
+  int mu_end(int n, int k) const { return mu_end_[n].empty() ? -1 : mu_end_[n][k]; }
+  /// The lambda "points" of element n (Sect. 3.2.2): start (m' = 0), stages, end boundary.
+  const std::vector<std::vector<int>>& lambda_points(int n) const { return points_[n]; }
+  /// Every (28) product, standard ones included: the complementarity residual is their max.
+  const std::vector<CompPair>& residual_pairs() const { return residual_pairs_; }
+  /// The complementarity constraints in the form chosen by cross_comp_mode.
+  const std::vector<CompGroup>& groups() const { return groups_; }
+  /// Step-equilibration rows (31), for eta reporting; -1 if none.
+  const std::vector<int>& step_eq_rows() const { return step_eq_rows_; }
+  /// eta_n (31) at a solution x, n = 1..N_FE-1 (entry 0 unused, set to NaN).
+  std::vector<double> eta(const double* x) const;
+
+ private:
+  int idx(int n, int m) const { return n * n_s_ + m; }
+  void build_complementarity();
+
+  const Pss& model_;
+  Tableau tab_;
+  DiscretizationOptions opt_;
+  IntervalInputs in_;
+  int N_FE_ = 0, n_s_ = 0;
+  bool stiffly_accurate_ = false;
+  std::vector<std::vector<int>> x_;
+  std::vector<int> h_, V_, X_, theta_, lambda_, mu_;
+  std::vector<std::vector<int>> lambda_end_, mu_end_;
+  std::vector<std::vector<std::vector<int>>> points_;
+  std::vector<CompPair> residual_pairs_;
+  std::vector<CompGroup> groups_;
+  std::vector<int> step_eq_rows_;
+};
+
+}  // namespace fesd::discretization

@@ -1,0 +1,214 @@
+// src/io/json_csv.cpp: integrator results as JSON (every field of IntegratorResult) and as CSV
+// (the states at the finite-element boundaries). See include/fesd/io.hpp.
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "fesd/error.hpp"
+#include "fesd/io.hpp"
+
+namespace fesd {
+namespace {
+
+// ordered_json keeps the keys in the documented order.
+using json = nlohmann::ordered_json;
+
+// Non-finite numbers have no JSON spelling: they become null.
+json number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+json array(const std::vector<double>& v) {
+  json a = json::array();
+  for (double d : v) a.push_back(number(d));
+  return a;
+}
+
+json array(const Eigen::VectorXd& v) {
+  json a = json::array();
+  for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(number(v[i]));
+  return a;
+}
+
+// One row per entry (one row per time point or stage point).
+json rows(const std::vector<Eigen::VectorXd>& v) {
+  json a = json::array();
+  for (const Eigen::VectorXd& row : v) a.push_back(array(row));
+  return a;
+}
+
+json stats(const Summary& s) {
+  return json{{"homotopy_steps", s.homotopy_steps},   {"nlp_iterations", s.nlp_iterations},
+              {"wall_s", number(s.wall_s)},           {"derivative_s", number(s.derivative_s)},
+              {"solver_s", number(s.solver_s)},       {"setup_s", number(s.setup_s)},
+              {"max_comp_residual", number(s.max_comp_residual)}};
+}
+
+json switches(const std::vector<SwitchEvent>& events) {
+  json a = json::array();
+  for (const SwitchEvent& e : events) {
+    a.push_back(json{{"t", number(e.t)},
+                     {"element", e.element},
+                     {"before", e.before},
+                     {"after", e.after}});
+  }
+  return a;
+}
+
+json homotopy(const std::vector<std::vector<HomotopyRow>>& steps) {
+  json a = json::array();
+  for (const std::vector<HomotopyRow>& step : steps) {
+    json rows_of_step = json::array();
+    for (const HomotopyRow& r : step) {
+      rows_of_step.push_back(json{{"k", r.k},
+                                  {"sigma", number(r.sigma)},
+                                  {"comp_residual", number(r.comp_residual)},
+                                  {"objective", number(r.objective)},
+                                  {"inf_pr", number(r.inf_pr)},
+                                  {"nlp_iterations", r.nlp_iterations},
+                                  {"nlp_status", r.nlp_status},
+                                  {"cpu_s", number(r.cpu_s)}});
+    }
+    a.push_back(std::move(rows_of_step));
+  }
+  return a;
+}
+
+// RFC 4180 quoting, needed only if a state name contains a comma, a quote or a line break.
+std::string csv_field(const std::string& s) {
+  if (s.find_first_of(",\"\r\n") == std::string::npos) return s;
+  std::string out = "\"";
+  for (char ch : s) {
+    if (ch == '"') out += '"';
+    out += ch;
+  }
+  out += '"';
+  return out;
+}
+
+void append_number(std::string& out, double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  out += buf;
+}
+
+std::string compact(const json& j) { return j.dump(-1, ' ', false, json::error_handler_t::replace); }
+
+bool is_container(const json& j) { return j.is_array() || j.is_object(); }
+
+// Readable without being huge: the top-level keys one per line, arrays of arrays or objects one
+// element per line (a row of x, a homotopy row), everything else on one line. Invalid UTF-8 in
+// messages and names is replaced instead of throwing.
+void pretty(const json& j, int depth, std::string& out) {
+  const std::string pad(static_cast<std::size_t>(2 * (depth + 1)), ' ');
+  const std::string close_pad(static_cast<std::size_t>(2 * depth), ' ');
+  if (j.is_object() && depth == 0 && !j.empty()) {
+    out += "{\n";
+    bool first = true;
+    for (auto it = j.begin(); it != j.end(); ++it) {
+      if (!first) out += ",\n";
+      first = false;
+      out += pad;
+      out += compact(json(it.key()));
+      out += ": ";
+      pretty(it.value(), depth + 1, out);
+    }
+    out += "\n";
+    out += close_pad;
+    out += '}';
+  } else if (j.is_array() && !j.empty() &&
+             std::all_of(j.begin(), j.end(), [](const json& e) { return is_container(e); })) {
+    out += "[\n";
+    bool first = true;
+    for (const json& e : j) {
+      if (!first) out += ",\n";
+      first = false;
+      out += pad;
+      pretty(e, depth + 1, out);
+    }
+    out += "\n";
+    out += close_pad;
+    out += ']';
+  } else {
+    out += compact(j);
+  }
+}
+
+std::vector<std::string> state_names_of(const IntegratorResult& result, const Pss& model) {
+  std::size_t n = static_cast<std::size_t>(model.n_x());
+  if (!result.x.empty()) n = static_cast<std::size_t>(result.x.front().size());
+  std::vector<std::string> names(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (i < model.state_names.size() && !model.state_names[i].empty()) {
+      names[i] = model.state_names[i];
+    } else {
+      names[i] = 'x' + std::to_string(i + 1);
+    }
+  }
+  return names;
+}
+
+void write_output_file(const std::string& path, const std::string& content) {
+  std::FILE* f = std::fopen(path.c_str(), "wb");
+  if (f == nullptr) throw IoError("cannot write '" + path + "': " + std::strerror(errno));
+  const std::size_t written = std::fwrite(content.data(), 1, content.size(), f);
+  const int write_errno = errno;
+  const bool failed = written != content.size() || std::ferror(f) != 0;
+  if (std::fclose(f) != 0 || failed) {
+    const int e = failed ? write_errno : errno;
+    throw IoError("cannot write '" + path + "': " + std::strerror(e != 0 ? e : EIO));
+  }
+}
+
+}  // namespace
+
+void write_json(const IntegratorResult& result, const Pss& model, const std::string& path) {
+  json j;
+  j["status"] = std::string(to_string(result.status));
+  j["message"] = result.message;
+  j["t"] = array(result.t);
+  j["x"] = rows(result.x);
+  j["h"] = array(result.h);
+  j["switch_times"] = array(result.switch_times());
+  j["x_final"] = array(result.x_final());
+  j["stats"] = stats(result.summary);
+  j["t_stage"] = array(result.t_stage);
+  j["x_stage"] = rows(result.x_stage);
+  j["theta"] = rows(result.theta);
+  j["lambda"] = rows(result.lambda);
+  j["mu"] = rows(result.mu);
+  j["active_set"] = result.active_set;
+  j["switches"] = switches(result.switches);
+  j["homotopy"] = homotopy(result.homotopy);
+  j["state_names"] = state_names_of(result, model);
+  std::string text;
+  pretty(j, 0, text);
+  text += '\n';
+  write_output_file(path, text);
+}
+
+void write_csv(const IntegratorResult& result, const Pss& model, const std::string& path) {
+  const std::vector<std::string> names = state_names_of(result, model);
+  std::string out = "t";
+  for (const std::string& name : names) {
+    out += ',';
+    out += csv_field(name);
+  }
+  out += "\n";
+  const std::size_t n_rows = std::min(result.t.size(), result.x.size());
+  for (std::size_t n = 0; n < n_rows; ++n) {
+    append_number(out, result.t[n]);
+    for (Eigen::Index i = 0; i < result.x[n].size(); ++i) {
+      out += ',';
+      append_number(out, result.x[n][i]);
+    }
+    out += '\n';
+  }
+  write_output_file(path, out);
+}
+
+}  // namespace fesd

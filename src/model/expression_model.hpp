@@ -1,0 +1,72 @@
+// src/model/expression_model.hpp: a PSS whose switching functions c, indicator functions g and
+// region vector fields f_i are parsed math expressions (problem files, docs/problem-files.md).
+//
+// Every expression reads one input vector, the symbols in this order:
+//
+//   [ x_0 .. x_{n_x_slots-1},  u_0 .. u_{n_u-1},  p_0 .. p_{n_p-1} ]
+//
+// n_x_slots is n_x or n_x + 1: the problem-file reader always offers the time `t` as the symbol
+// after the states; if no expression reads it, the model has no clock state and that slot holds 0.
+// If one does, a clock state t' = 1 is part of x and the slot is the clock (n_x_slots = n_x).
+//
+// The regions of all subsystems are numbered in order (subsystem 0's regions first), as for every
+// fesd::Pss: c (resp. g) of all c-form (g-form) subsystems are concatenated, eq. (13) and (21).
+#pragma once
+#include <memory>
+#include <vector>
+
+#include "fesd/model.hpp"
+#include "model/expression.hpp"
+
+namespace fesd {
+
+/// The expressions of one subsystem k of (20)-(21): either c^k (c-form, the sign matrix lives in
+/// fesd::Subsystem) or g^k (g-form), and one vector field f_i^k per region, n_x expressions each.
+struct ExpressionSubsystem {
+  std::vector<expr::Expression> c;               ///< switching functions c^k(x, p), may be empty
+  std::vector<expr::Expression> g;               ///< indicator functions g^k(x, p), may be empty
+  std::vector<std::vector<expr::Expression>> F;  ///< F[i][j] = component j of f_i^k(x, u, p)
+};
+
+/// Sizes of the symbol vector the expressions were parsed with.
+struct ExpressionLayout {
+  int n_x = 0;        ///< states of the Pss (the clock included, if any)
+  int n_x_slots = 0;  ///< state slots in the symbol vector: n_x or n_x + 1 (unused time slot)
+  int n_u = 0;
+  int n_p = 0;
+  int n_symbols() const { return n_x_slots + n_u + n_p; }
+};
+
+/// fesd::PssFunctions evaluating parsed expressions, for every scalar type. c and g must not read
+/// controls (PssFunctions::c and ::g get no u); the constructor checks this and all sizes and
+/// throws fesd::InvalidModel.
+class ExpressionModel final : public PssFunctions {
+ public:
+  ExpressionModel(ExpressionLayout layout, std::vector<ExpressionSubsystem> subsystems);
+
+  const ExpressionLayout& layout() const { return layout_; }
+  int n_regions() const { return static_cast<int>(fields_.size()); }
+
+#define FESD_DECLARE_EXPRESSION_FUNCTIONS(T)                                          \
+  void c(const T* x, const T* p, T* c_out) const override;                            \
+  void g(const T* x, const T* p, T* g_out) const override;                            \
+  void f(int region, const T* x, const T* u, const T* p, T* f_out) const override;
+  FESD_FOR_EACH_SCALAR(FESD_DECLARE_EXPRESSION_FUNCTIONS)
+#undef FESD_DECLARE_EXPRESSION_FUNCTIONS
+
+ private:
+  template <class T>
+  void eval_list(const std::vector<expr::Expression>& list, const T* x, const T* u, const T* p,
+                 T* out) const;
+
+  ExpressionLayout layout_;
+  std::vector<expr::Expression> c_;                   // all c-form subsystems' c, concatenated
+  std::vector<expr::Expression> g_;                   // all g-form subsystems' g, concatenated
+  std::vector<std::vector<expr::Expression>> fields_;  // one per region over all subsystems
+};
+
+/// Convenience: the Pss of an ExpressionModel (dims.n_x, n_u, n_p must match the layout).
+Pss make_expression_pss(PssDims dims, ExpressionLayout layout,
+                        std::vector<ExpressionSubsystem> subsystems);
+
+}  // namespace fesd

@@ -1,0 +1,229 @@
+// IPOPT backend: a TNLP over a BlockNlp, one IpoptApplication reused for every solve.
+// Exceptions never cross IPOPT: evaluations return false on non-finite values and IPOPT cuts the
+// step; the status comes back in NlpResult.
+#include "nlp/ipopt_solver.hpp"
+
+#include <chrono>
+#include <cstdlib>
+#include <string>
+
+#include <IpIpoptApplication.hpp>
+#include <IpRegOptions.hpp>
+#include <IpSolveStatistics.hpp>
+#include <IpTNLP.hpp>
+#include <fmt/format.h>
+
+#include "fesd/error.hpp"
+
+namespace fesd::nlp {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+std::string status_name(Ipopt::ApplicationReturnStatus s) {
+  switch (s) {
+    case Ipopt::Solve_Succeeded: return "Solve_Succeeded";
+    case Ipopt::Solved_To_Acceptable_Level: return "Solved_To_Acceptable_Level";
+    case Ipopt::Infeasible_Problem_Detected: return "Infeasible_Problem_Detected";
+    case Ipopt::Search_Direction_Becomes_Too_Small: return "Search_Direction_Becomes_Too_Small";
+    case Ipopt::Diverging_Iterates: return "Diverging_Iterates";
+    case Ipopt::User_Requested_Stop: return "User_Requested_Stop";
+    case Ipopt::Feasible_Point_Found: return "Feasible_Point_Found";
+    case Ipopt::Maximum_Iterations_Exceeded: return "Maximum_Iterations_Exceeded";
+    case Ipopt::Restoration_Failed: return "Restoration_Failed";
+    case Ipopt::Error_In_Step_Computation: return "Error_In_Step_Computation";
+    case Ipopt::Maximum_CpuTime_Exceeded: return "Maximum_CpuTime_Exceeded";
+    case Ipopt::Not_Enough_Degrees_Of_Freedom: return "Not_Enough_Degrees_Of_Freedom";
+    case Ipopt::Invalid_Problem_Definition: return "Invalid_Problem_Definition";
+    case Ipopt::Invalid_Option: return "Invalid_Option";
+    case Ipopt::Invalid_Number_Detected: return "Invalid_Number_Detected";
+    case Ipopt::Unrecoverable_Exception: return "Unrecoverable_Exception";
+    case Ipopt::NonIpopt_Exception_Thrown: return "NonIpopt_Exception_Thrown";
+    case Ipopt::Insufficient_Memory: return "Insufficient_Memory";
+    case Ipopt::Internal_Error: return "Internal_Error";
+  }
+  return "Unknown_Status";
+}
+
+class BlockTnlp final : public Ipopt::TNLP {
+ public:
+  BlockTnlp(const BlockNlp& nlp, Iterate& it, bool warm) : nlp_(nlp), it_(it), warm_(warm) {}
+
+  bool get_nlp_info(Ipopt::Index& n, Ipopt::Index& m, Ipopt::Index& nnz_jac,
+                    Ipopt::Index& nnz_h, IndexStyleEnum& style) override {
+    n = nlp_.num_variables();
+    m = nlp_.num_constraints();
+    nnz_jac = nlp_.jac_nnz();
+    nnz_h = nlp_.hess_nnz();
+    style = C_STYLE;
+    return true;
+  }
+  bool get_bounds_info(Ipopt::Index n, Ipopt::Number* x_l, Ipopt::Number* x_u, Ipopt::Index m,
+                       Ipopt::Number* g_l, Ipopt::Number* g_u) override {
+    std::copy_n(nlp_.x_lb.data(), n, x_l);
+    std::copy_n(nlp_.x_ub.data(), n, x_u);
+    std::copy_n(nlp_.g_lb.data(), m, g_l);
+    std::copy_n(nlp_.g_ub.data(), m, g_u);
+    return true;
+  }
+  bool get_starting_point(Ipopt::Index n, bool init_x, Ipopt::Number* x, bool init_z,
+                          Ipopt::Number* z_L, Ipopt::Number* z_U, Ipopt::Index m,
+                          bool init_lambda, Ipopt::Number* lambda) override {
+    if (init_x) std::copy_n(it_.x.data(), n, x);
+    if (init_z || init_lambda) {
+      if (!warm_ || !it_.has_duals()) return false;
+      if (init_z) {
+        std::copy_n(it_.z_L.data(), n, z_L);
+        std::copy_n(it_.z_U.data(), n, z_U);
+      }
+      if (init_lambda) std::copy_n(it_.lambda.data(), m, lambda);
+    }
+    return true;
+  }
+  bool eval_f(Ipopt::Index, const Ipopt::Number* x, bool, Ipopt::Number& f) override {
+    return timed([&] { return nlp_.eval_f(x, f); });
+  }
+  bool eval_grad_f(Ipopt::Index, const Ipopt::Number* x, bool, Ipopt::Number* g) override {
+    return timed([&] { return nlp_.eval_grad_f(x, g); });
+  }
+  bool eval_g(Ipopt::Index, const Ipopt::Number* x, bool, Ipopt::Index, Ipopt::Number* g) override {
+    return timed([&] { return nlp_.eval_g(x, g); });
+  }
+  bool eval_jac_g(Ipopt::Index, const Ipopt::Number* x, bool, Ipopt::Index, Ipopt::Index,
+                  Ipopt::Index* rows, Ipopt::Index* cols, Ipopt::Number* values) override {
+    if (values == nullptr) {
+      std::copy(nlp_.jac_rows().begin(), nlp_.jac_rows().end(), rows);
+      std::copy(nlp_.jac_cols().begin(), nlp_.jac_cols().end(), cols);
+      return true;
+    }
+    return timed([&] { return nlp_.eval_jac_g(x, values); });
+  }
+  bool eval_h(Ipopt::Index, const Ipopt::Number* x, bool, Ipopt::Number obj_factor, Ipopt::Index,
+              const Ipopt::Number* lambda, bool, Ipopt::Index, Ipopt::Index* rows,
+              Ipopt::Index* cols, Ipopt::Number* values) override {
+    if (values == nullptr) {
+      std::copy(nlp_.hess_rows().begin(), nlp_.hess_rows().end(), rows);
+      std::copy(nlp_.hess_cols().begin(), nlp_.hess_cols().end(), cols);
+      return true;
+    }
+    return timed([&] { return nlp_.eval_h(x, obj_factor, lambda, values); });
+  }
+  void finalize_solution(Ipopt::SolverReturn, Ipopt::Index n, const Ipopt::Number* x,
+                         const Ipopt::Number* z_L, const Ipopt::Number* z_U, Ipopt::Index m,
+                         const Ipopt::Number*, const Ipopt::Number* lambda, Ipopt::Number obj,
+                         const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
+    it_.x.assign(x, x + n);
+    it_.z_L.assign(z_L, z_L + n);
+    it_.z_U.assign(z_U, z_U + n);
+    it_.lambda.assign(lambda, lambda + m);
+    objective_ = obj;
+  }
+  bool intermediate_callback(Ipopt::AlgorithmMode, Ipopt::Index iter, Ipopt::Number,
+                             Ipopt::Number inf_pr, Ipopt::Number inf_du, Ipopt::Number,
+                             Ipopt::Number, Ipopt::Number, Ipopt::Number, Ipopt::Number,
+                             Ipopt::Index, const Ipopt::IpoptData*,
+                             Ipopt::IpoptCalculatedQuantities*) override {
+    iterations_ = iter;
+    inf_pr_ = inf_pr;
+    inf_du_ = inf_du;
+    return true;
+  }
+
+  double eval_s() const { return eval_s_; }
+  int eval_failures() const { return eval_failures_; }
+  double objective() const { return objective_; }
+  int iterations() const { return iterations_; }
+  double inf_pr() const { return inf_pr_; }
+  double inf_du() const { return inf_du_; }
+
+ private:
+  template <class Fn>
+  bool timed(Fn&& fn) {
+    const auto t0 = Clock::now();
+    const bool ok = fn();
+    eval_s_ += seconds_since(t0);
+    if (!ok) ++eval_failures_;
+    return ok;
+  }
+  const BlockNlp& nlp_;
+  Iterate& it_;
+  bool warm_;
+  double eval_s_ = 0, objective_ = 0, inf_pr_ = 0, inf_du_ = 0;
+  int eval_failures_ = 0, iterations_ = 0;
+};
+
+void set_option(Ipopt::IpoptApplication& app, const std::string& name, const std::string& value) {
+  Ipopt::SmartPtr<const Ipopt::RegisteredOption> opt = app.RegOptions()->GetOption(name);
+  if (!Ipopt::IsValid(opt))
+    throw InvalidOption(fmt::format("ipopt.{}: not an IPOPT option", name));
+  bool ok = false;
+  switch (opt->Type()) {
+    case Ipopt::OT_Number: {
+      char* end = nullptr;
+      const double v = std::strtod(value.c_str(), &end);
+      ok = end != value.c_str() && *end == '\0' && app.Options()->SetNumericValue(name, v);
+      break;
+    }
+    case Ipopt::OT_Integer: {
+      char* end = nullptr;
+      const long v = std::strtol(value.c_str(), &end, 10);
+      ok = end != value.c_str() && *end == '\0' &&
+           app.Options()->SetIntegerValue(name, static_cast<Ipopt::Index>(v));
+      break;
+    }
+    default: ok = app.Options()->SetStringValue(name, value); break;
+  }
+  if (!ok) throw InvalidOption(fmt::format("ipopt.{} = '{}': IPOPT rejects this value", name, value));
+}
+
+}  // namespace
+
+struct IpoptSolver::Impl {
+  Ipopt::SmartPtr<Ipopt::IpoptApplication> app;
+};
+
+IpoptSolver::IpoptSolver(const NlpOptions& o) : impl_(std::make_unique<Impl>()) {
+  impl_->app = IpoptApplicationFactory();
+  Ipopt::IpoptApplication& app = *impl_->app;
+  app.Options()->SetStringValue("sb", "yes");  // no banner
+  app.Options()->SetIntegerValue("print_level", o.print_level);
+  app.Options()->SetNumericValue("tol", o.tol);
+  app.Options()->SetNumericValue("acceptable_tol", o.acceptable_tol);
+  app.Options()->SetIntegerValue("max_iter", o.max_iter);
+  app.Options()->SetStringValue("mu_strategy", "adaptive");
+  app.Options()->SetStringValue("print_timing_statistics", "no");
+  // IPOPT relaxes every bound by 1e-8 by default, so "product <= sigma" would only hold up to
+  // 1e-8: complementarity could never get below that. Bounds are kept exact.
+  app.Options()->SetNumericValue("bound_relax_factor", 0.0);
+  for (const auto& [name, value] : o.extra) set_option(app, name, value);
+  if (app.Initialize() != Ipopt::Solve_Succeeded)
+    throw InvalidOption("ipopt: initialization failed (check the [ipopt] options)");
+}
+
+IpoptSolver::~IpoptSolver() = default;
+
+NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_start) {
+  const auto t0 = Clock::now();
+  Ipopt::IpoptApplication& app = *impl_->app;
+  const bool warm = warm_start && start.has_duals();
+  app.Options()->SetStringValue("warm_start_init_point", warm ? "yes" : "no");
+  Ipopt::SmartPtr<BlockTnlp> tnlp = new BlockTnlp(nlp, start, warm);
+  const Ipopt::ApplicationReturnStatus s = app.OptimizeTNLP(Ipopt::SmartPtr<Ipopt::TNLP>(
+      Ipopt::GetRawPtr(tnlp)));
+  NlpResult r;
+  r.status = status_name(s);
+  r.success = s == Ipopt::Solve_Succeeded || s == Ipopt::Solved_To_Acceptable_Level;
+  r.eval_error = tnlp->eval_failures() > 0 && !r.success;
+  r.iterations = tnlp->iterations();
+  r.objective = tnlp->objective();
+  r.inf_pr = tnlp->inf_pr();
+  r.inf_du = tnlp->inf_du();
+  r.eval_s = tnlp->eval_s();
+  r.total_s = seconds_since(t0);
+  return r;
+}
+
+}  // namespace fesd::nlp

@@ -1,0 +1,35 @@
+// src/nlp/nlp_solver.hpp: the small interface the MPCC layer solves NLPs through. IPOPT + MUMPS is
+// the one backend today; a structure-exploiting solver can replace it behind this interface.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "fesd/options.hpp"
+#include "nlp/block_nlp.hpp"
+
+namespace fesd::nlp {
+
+/// Primal-dual point: x, constraint multipliers, bound multipliers.
+struct Iterate {
+  std::vector<double> x, lambda, z_L, z_U;
+  bool has_duals() const { return !lambda.empty(); }
+};
+
+struct NlpResult {
+  bool success = false;       ///< converged (to tol or acceptable_tol)
+  bool eval_error = false;    ///< stopped because evaluations kept failing (NaN/inf)
+  std::string status;         ///< backend status name, e.g. "Solve_Succeeded"
+  int iterations = 0;
+  double objective = 0, inf_pr = 0, inf_du = 0;
+  double eval_s = 0;          ///< time spent in function and derivative evaluations
+  double total_s = 0;         ///< wall time of the whole solve
+};
+
+class NlpSolver {
+ public:
+  virtual ~NlpSolver() = default;
+  /// Solves from `start` (x; with duals when warm-starting) and overwrites it with the solution.
+  virtual NlpResult solve(const BlockNlp& nlp, Iterate& start, bool warm_start) = 0;
+};
+
+}  // namespace fesd::nlp

@@ -1,0 +1,219 @@
+// tests/bad_input/problem_file_errors_test.cpp: every mistake in a problem file is one exception
+// with a one-line message that names the file, the line and the key.
+//
+// Problem files: tests/bad_input/files/<mistake>.toml, one per mistake. Each starts with
+//   # expect: <ProblemFileError | ExpressionError | InvalidOption | InvalidModel>
+//   # message: <a substring the message must contain>      (one or more lines)
+// and the test loads it and checks both. Overrides (apply_override) are checked inline below.
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <fesd/error.hpp>
+#include <fesd/problem_file.hpp>
+
+namespace fesd {
+namespace {
+
+const std::string kFilesDir = std::string(FESD_SOURCE_DIR) + "/tests/bad_input/files";
+
+/// The most specific fesd exception class of `e`.
+std::string kind_of(const Error& e) {
+  if (dynamic_cast<const ProblemFileError*>(&e) != nullptr) return "ProblemFileError";
+  if (dynamic_cast<const ExpressionError*>(&e) != nullptr) return "ExpressionError";
+  if (dynamic_cast<const InvalidOption*>(&e) != nullptr) return "InvalidOption";
+  if (dynamic_cast<const InvalidModel*>(&e) != nullptr) return "InvalidModel";
+  return "Error";
+}
+
+struct Outcome {
+  std::string kind = "<no exception>";
+  std::string message;
+};
+
+template <class F>
+Outcome outcome_of(F&& f) {
+  Outcome o;
+  try {
+    f();
+  } catch (const Error& e) {
+    o.kind = kind_of(e);
+    o.message = e.what();
+  }
+  return o;
+}
+
+// ---- one file per mistake -------------------------------------------------------------------
+
+std::vector<std::string> bad_files() {
+  std::vector<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(kFilesDir))
+    if (entry.path().extension() == ".toml") names.push_back(entry.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+class BadProblemFile : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(BadProblemFile, ThrowsWithMessage) {
+  const std::string path = kFilesDir + "/" + GetParam();
+  std::ifstream in(path);
+  ASSERT_TRUE(in) << path;
+  std::string expect_kind;
+  std::vector<std::string> expect_messages;
+  for (std::string line; std::getline(in, line) && line.rfind('#', 0) == 0;) {
+    if (line.rfind("# expect: ", 0) == 0) expect_kind = line.substr(10);
+    if (line.rfind("# message: ", 0) == 0) expect_messages.push_back(line.substr(11));
+  }
+  ASSERT_FALSE(expect_kind.empty()) << path << ": no '# expect:' header";
+  ASSERT_FALSE(expect_messages.empty()) << path << ": no '# message:' header";
+
+  const Outcome o = outcome_of([&] { load_simulation_problem(path); });
+  EXPECT_EQ(o.kind, expect_kind) << o.message;
+  for (const std::string& m : expect_messages)
+    EXPECT_NE(o.message.find(m), std::string::npos)
+        << "message:  " << o.message << "\nexpected: " << m;
+  EXPECT_EQ(o.message.find('\n'), std::string::npos) << "one line: " << o.message;
+  EXPECT_EQ(o.message.rfind(path, 0), 0U) << "starts with the file name: " << o.message;
+}
+
+INSTANTIATE_TEST_SUITE_P(Files, BadProblemFile, ::testing::ValuesIn(bad_files()),
+                         [](const ::testing::TestParamInfo<std::string>& param_info) {
+                           return param_info.param.substr(0, param_info.param.find('.'));
+                         });
+
+TEST(BadProblemFileDirectory, HasOneFilePerMistake) {
+  // Guards against the parameterised test silently running nothing.
+  EXPECT_GE(bad_files().size(), 50U);
+}
+
+// ---- reading the file itself ----------------------------------------------------------------
+
+TEST(BadProblemFileIo, MissingFile) {
+  const Outcome o = outcome_of([] { load_simulation_problem("/nonexistent/dir/model.toml"); });
+  EXPECT_EQ(o.kind, "ProblemFileError");
+  EXPECT_EQ(o.message, "/nonexistent/dir/model.toml: cannot read problem file (no such file)");
+}
+
+TEST(BadProblemFileIo, DirectoryInsteadOfFile) {
+  const Outcome o = outcome_of([] { load_simulation_problem(kFilesDir); });
+  EXPECT_EQ(o.kind, "ProblemFileError");
+  EXPECT_NE(o.message.find("not a regular file"), std::string::npos) << o.message;
+}
+
+TEST(BadProblemFileText, SyntaxErrorHasLineAndColumn) {
+  const Outcome o = outcome_of([] {
+    parse_simulation_problem("[model]\nx = [\"x1\"]\nx0 = [1.0,, 2.0]\n", "inline.toml");
+  });
+  EXPECT_EQ(o.kind, "ProblemFileError");
+  EXPECT_EQ(o.message.rfind("inline.toml:3:", 0), 0U) << o.message;
+  EXPECT_NE(o.message.find("TOML syntax error"), std::string::npos) << o.message;
+}
+
+TEST(BadProblemFileText, DuplicateKeyIsASyntaxError) {
+  const Outcome o = outcome_of([] {
+    parse_simulation_problem("[simulation]\nT_sim = 1\nT_sim = 2\n", "dup.toml");
+  });
+  EXPECT_EQ(o.kind, "ProblemFileError");
+  EXPECT_EQ(o.message.rfind("dup.toml:3:", 0), 0U) << o.message;
+}
+
+TEST(BadProblemFileText, SeveralOptionErrorsAreReportedTogether) {
+  const Outcome o = outcome_of([] {
+    parse_simulation_problem(R"toml(
+[model]
+x = ["x"]
+c = ["x"]
+F = [["1"], ["-1"]]
+x0 = [0]
+[simulation]
+T_sim = 1
+[homotopy]
+sigma_0 = -1.0
+N_homotopy = 0
+)toml",
+                             "two.toml");
+  });
+  EXPECT_EQ(o.kind, "InvalidOption");
+  EXPECT_NE(o.message.find("two.toml:10: homotopy.sigma_0 = -1: must be > 0"), std::string::npos)
+      << o.message;
+  EXPECT_NE(o.message.find("two.toml:11: homotopy.N_homotopy = 0: must be in 1..1000"),
+            std::string::npos)
+      << o.message;
+}
+
+// ---- overrides ------------------------------------------------------------------------------
+
+constexpr const char* kValid = R"toml(
+[model]
+x = ["x"]
+u = ["u1"]
+c = ["x"]
+F = [["u1"], ["-1"]]
+x0 = [0]
+[simulation]
+T_sim = 1
+)toml";
+
+struct OverrideCase {
+  const char* key;
+  const char* value;
+  const char* message;  // a substring of the InvalidOption message
+};
+
+class BadOverride : public ::testing::TestWithParam<OverrideCase> {};
+
+TEST_P(BadOverride, ThrowsInvalidOptionAndLeavesProblemUnchanged) {
+  const OverrideCase& c = GetParam();
+  SimulationProblem q = parse_simulation_problem(kValid, "valid.toml");
+  const Outcome o = outcome_of([&] { apply_override(q, c.key, c.value); });
+  EXPECT_EQ(o.kind, "InvalidOption") << o.message;
+  EXPECT_NE(o.message.find(c.message), std::string::npos)
+      << "message:  " << o.message << "\nexpected: " << c.message;
+  // Nothing was changed by the failed override.
+  const SimulationProblem fresh = parse_simulation_problem(kValid, "valid.toml");
+  EXPECT_EQ(q.options.discretization.n_s, fresh.options.discretization.n_s);
+  EXPECT_EQ(q.options.discretization.N_FE, fresh.options.discretization.N_FE);
+  EXPECT_EQ(q.options.discretization.use_fesd, fresh.options.discretization.use_fesd);
+  EXPECT_EQ(q.options.homotopy.sigma_0, fresh.options.homotopy.sigma_0);
+  EXPECT_EQ(q.T_sim, fresh.T_sim);
+  EXPECT_EQ(q.N_sim, fresh.N_sim);
+  EXPECT_EQ(q.u, fresh.u);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Overrides, BadOverride,
+    ::testing::Values(
+        OverrideCase{"n_S", "3", "--n_S = 3: unknown option 'n_S' (did you mean 'n_s'?)"},
+        OverrideCase{"discretization.sigma_0", "3", "unknown option 'sigma_0'"},
+        OverrideCase{"solver.tol", "1", "--solver.tol = 1: unknown table 'solver'"},
+        OverrideCase{"n_s", "0", "--n_s = 0: must be in 1..9 for radau_iia"},
+        OverrideCase{"n_s", "three", "--n_s = three: expected an integer"},
+        OverrideCase{"n_s", "2.5", "--n_s = 2.5: expected an integer"},
+        OverrideCase{"N_FE", "1",
+                     "--N_FE = 1: discretization.N_finite_elements = 1: FESD needs >= 2"},
+        OverrideCase{"use_fesd", "yes",
+                     "--use_fesd = yes: expected a boolean (1, 0, true or false, got \"yes\")"},
+        OverrideCase{"rk_scheme", "rk4",
+                     "--rk_scheme = rk4: unknown name (expected one of radau_iia, "
+                     "gauss_legendre, lobatto_iiia, lobatto_iiic, explicit_rk; got \"rk4\")"},
+        OverrideCase{"cross_comp_mode", "all", "--cross_comp_mode = all: unknown name"},
+        OverrideCase{"step_equilibration", "", "--step_equilibration = : unknown name"},
+        OverrideCase{"T_sim", "nan", "--T_sim = nan: must be finite"},
+        OverrideCase{"T_sim", "-2", "--T_sim = -2: must be > 0"},
+        OverrideCase{"N_sim", "0", "--N_sim = 0: must be >= 1"},
+        OverrideCase{"sigma_0", "1e-20",
+                     "--sigma_0 = 1e-20: homotopy.sigma_N = 1e-12: must be <= sigma_0"},
+        OverrideCase{"print_level", "99", "--print_level = 99: must be in 0..12"},
+        OverrideCase{"u", "1, 2",
+                     "--u = 1, 2: wrong length (expected 1 numbers, one per control, got 2)"},
+        OverrideCase{"u", "abc", "--u = abc: expected comma-separated numbers"}),
+    [](const ::testing::TestParamInfo<OverrideCase>& param_info) {
+      return "case" + std::to_string(param_info.index);
+    });
+
+}  // namespace
+}  // namespace fesd
