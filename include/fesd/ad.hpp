@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <iterator>
 #include <utility>
 #include <vector>
 
@@ -48,8 +49,20 @@ struct Jet {
 };
 
 /// r = value + ca * grad(a) + cb * grad(b), with missing gradient entries taken as zero.
+/// Tells the optimizer that 0 <= n <= N (gradient lengths always are).
+template <int N>
+inline void assume_length(int n) {
+#if defined(__GNUC__)
+  if (n < 0 || n > N) __builtin_unreachable();
+#else
+  (void)n;
+#endif
+}
+
 template <int N>
 inline Jet<N> lincomb(double value, double ca, const Jet<N>& a, double cb, const Jet<N>& b) {
+  assume_length<N>(a.n);
+  assume_length<N>(b.n);
   Jet<N> r(value);
   const int lo = std::min(a.n, b.n);
   r.n = std::max(a.n, b.n);
@@ -61,6 +74,7 @@ inline Jet<N> lincomb(double value, double ca, const Jet<N>& a, double cb, const
 /// r = value + ca * grad(a).
 template <int N>
 inline Jet<N> scaled(double value, double ca, const Jet<N>& a) {
+  assume_length<N>(a.n);
   Jet<N> r(value);
   r.n = a.n;
   for (int i = 0; i < a.n; ++i) r.g[i] = ca * a.g[i];
@@ -351,9 +365,7 @@ inline Dual<T> pow(const Dual<T>& a, double p) {
   return {pow(a.v, p), (p * pow(a.v, p - 1.0)) * a.d};
 }
 template <class T>
-inline Dual<T> pow(const Dual<T>& a, const Dual<T>& b) {
-  return exp(b * log(a));
-}
+inline Dual<T> pow(const Dual<T>& a, const Dual<T>& b);  // defined below, after value_of
 template <class T>
 inline Dual<T> pow(double a, const Dual<T>& b) {
   return exp(b * std::log(a));
@@ -492,6 +504,24 @@ inline Dual<T> abs(const Dual<T>& a) {
   return {abs(a.v), s * a.d};
 }
 
+inline bool has_derivative(double) { return false; }
+template <int N>
+inline bool has_derivative(const Jet<N>& x) {
+  for (int i = 0; i < x.n; ++i)
+    if (x.g[i] != 0.0) return true;
+  return false;
+}
+template <class T>
+inline bool has_derivative(const Dual<T>& x) {
+  return has_derivative(x.v) || has_derivative(x.d) || value_of(x.d) != 0.0;
+}
+/// a^b; a constant exponent goes through pow(a, double), so negative bases work.
+template <class T>
+inline Dual<T> pow(const Dual<T>& a, const Dual<T>& b) {
+  if (!has_derivative(b)) return pow(a, value_of(b));
+  return exp(b * log(a));
+}
+
 #define FESD_AD_COMPARISONS(TYPE, TEMPLATE_HEAD)                                         \
   TEMPLATE_HEAD inline bool operator<(const TYPE& a, const TYPE& b) {                    \
     return value_of(a) < value_of(b);                                                    \
@@ -505,6 +535,14 @@ inline Dual<T> abs(const Dual<T>& a) {
   TEMPLATE_HEAD inline bool operator>=(const TYPE& a, const TYPE& b) {                   \
     return value_of(a) >= value_of(b);                                                   \
   }                                                                                      \
+  TEMPLATE_HEAD inline bool operator==(const TYPE& a, const TYPE& b) {                   \
+    return value_of(a) == value_of(b);                                                   \
+  }                                                                                      \
+  TEMPLATE_HEAD inline bool operator!=(const TYPE& a, const TYPE& b) {                   \
+    return value_of(a) != value_of(b);                                                   \
+  }                                                                                      \
+  TEMPLATE_HEAD inline bool operator==(const TYPE& a, double b) { return value_of(a) == b; } \
+  TEMPLATE_HEAD inline bool operator!=(const TYPE& a, double b) { return value_of(a) != b; } \
   TEMPLATE_HEAD inline bool operator<(const TYPE& a, double b) { return value_of(a) < b; }  \
   TEMPLATE_HEAD inline bool operator>(const TYPE& a, double b) { return value_of(a) > b; }  \
   TEMPLATE_HEAD inline bool operator<=(const TYPE& a, double b) { return value_of(a) <= b; } \

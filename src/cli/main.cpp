@@ -23,8 +23,8 @@
 #include <utility>
 #include <vector>
 
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
 #include "fesd/error.hpp"
 #include "fesd/integrator.hpp"
@@ -239,7 +239,9 @@ std::string join_vector(const Eigen::VectorXd& v, const std::vector<std::string>
   return names.empty() ? "[" + out + "]" : out;
 }
 
-std::string yes_no(bool b) { return b ? "1" : "0"; }
+std::string yes_no(bool b) {
+  return b ? "1" : "0";
+}
 
 void print_header(const fesd::SimulationProblem& problem) {
   const fesd::Pss& m = problem.model;
@@ -259,9 +261,9 @@ void print_header(const fesd::SimulationProblem& problem) {
   for (int k = 0; k < m.n_sys(); ++k) {
     const fesd::Subsystem& sub = m.dims().subsystems[static_cast<std::size_t>(k)];
     const int n_f = m.region_offset(k + 1) - m.region_offset(k);
-    regions += fmt::format("{}{} ({})", k ? ", " : "", n_f,
-                           sub.n_c > 0 ? fmt::format("n_c = {}", sub.n_c)
-                                       : fmt::format("n_g = {}", sub.n_g));
+    regions += fmt::format(
+        "{}{} ({})", k ? ", " : "", n_f,
+        sub.n_c > 0 ? fmt::format("n_c = {}", sub.n_c) : fmt::format("n_g = {}", sub.n_g));
   }
 
   fmt::print("fesd {}: {} ({})\n", FESD_VERSION, problem.name, problem.source);
@@ -271,8 +273,10 @@ void print_header(const fesd::SimulationProblem& problem) {
   fmt::print("  regions     {} subsystem{}, regions per subsystem: {} (n_theta = {})\n", m.n_sys(),
              m.n_sys() == 1 ? "" : "s", regions, m.n_theta());
   fmt::print("  x0          {}\n", join_vector(problem.x0));
-  if (problem.p.size() > 0) fmt::print("  p           {}\n", join_vector(problem.p, m.parameter_names));
-  if (problem.u.size() > 0) fmt::print("  u           {}\n", join_vector(problem.u, m.control_names));
+  if (problem.p.size() > 0)
+    fmt::print("  p           {}\n", join_vector(problem.p, m.parameter_names));
+  if (problem.u.size() > 0)
+    fmt::print("  u           {}\n", join_vector(problem.u, m.control_names));
   fmt::print("  scheme      {}, n_s = {}, N_FE = {}, use_fesd = {}", fesd::to_string(d.rk_scheme),
              d.n_s, d.N_FE, yes_no(d.use_fesd));
   if (d.use_fesd) {
@@ -325,10 +329,10 @@ int run_simulate(const SimulateArgs& args, const CLI::App& cmd) {
   if (want_plot) {
     const std::string ext = lower_extension(args.plot);
     if (ext != ".png" && ext != ".svg") {
-      throw UsageError("--plot '" + args.plot + "': unsupported " +
-                       (ext.empty() ? std::string("missing extension")
-                                    : "extension '" + ext + "'") +
-                       " (supported: .png, .svg)");
+      throw UsageError(
+          "--plot '" + args.plot + "': unsupported " +
+          (ext.empty() ? std::string("missing extension") : "extension '" + ext + "'") +
+          " (supported: .png, .svg)");
     }
     check_output_path("--plot", args.plot);
     if (!gnuplot_on_path()) {
@@ -344,8 +348,9 @@ int run_simulate(const SimulateArgs& args, const CLI::App& cmd) {
     std::fflush(stdout);
   }
   problem.options.progress = !args.quiet;
-  const fesd::IntegratorResult result = fesd::integrate(
-      problem.model, problem.x0, problem.T_sim, problem.N_sim, problem.options, problem.u, problem.p);
+  const fesd::IntegratorResult result =
+      fesd::integrate(problem.model, problem.x0, problem.T_sim, problem.N_sim, problem.options,
+                      problem.u, problem.p);
   std::fflush(stderr);
   const std::string report = result.full_report();
   fmt::print("{}", report);
@@ -367,9 +372,8 @@ int run_simulate(const SimulateArgs& args, const CLI::App& cmd) {
   };
   write(want_json, args.json, "JSON", [&] { fesd::write_json(result, problem.model, args.json); });
   write(want_csv, args.csv, "CSV ", [&] { fesd::write_csv(result, problem.model, args.csv); });
-  write(want_plot, args.plot, "plot", [&] {
-    fesd::write_plot(result, problem.model, args.plot, problem.name);
-  });
+  write(want_plot, args.plot, "plot",
+        [&] { fesd::write_plot(result, problem.model, args.plot, problem.name); });
   std::fflush(stdout);
 
   if (!io_errors.empty()) {
@@ -389,9 +393,10 @@ int run_simulate(const SimulateArgs& args, const CLI::App& cmd) {
 }
 
 int run(int argc, char** argv) {
-  CLI::App app{"fesd: simulate piecewise smooth (Filippov) systems with Finite Elements with "
-               "Switch Detection",
-               "fesd"};
+  CLI::App app{
+      "fesd: simulate piecewise smooth (Filippov) systems with Finite Elements with "
+      "Switch Detection",
+      "fesd"};
   app.set_version_flag("--version", std::string("fesd ") + FESD_VERSION);
   app.require_subcommand(0, 1);
 
@@ -408,7 +413,8 @@ int run(int argc, char** argv) {
 
   std::string check_file;
   Overrides check_overrides;
-  CLI::App* check_cmd = app.add_subcommand("check", "load and validate a problem file, do not solve");
+  CLI::App* check_cmd =
+      app.add_subcommand("check", "load and validate a problem file, do not solve");
   check_cmd->add_option("FILE", check_file, "problem file (TOML)")->required();
   check_overrides.add_to(*check_cmd);
 
@@ -417,8 +423,8 @@ int run(int argc, char** argv) {
     const std::string_view arg = argv[i];
     if (arg.empty() || arg.front() == '-') continue;
     if (arg != "simulate" && arg != "check") {
-      print_error(fmt::format("unknown command '{}' (commands: simulate, check; see fesd --help)",
-                              arg));
+      print_error(
+          fmt::format("unknown command '{}' (commands: simulate, check; see fesd --help)", arg));
       return kExitBadInput;
     }
     break;
@@ -447,7 +453,8 @@ int main(int argc, char** argv) {
   } catch (const fesd::IoError& e) {
     print_error(e.what());
     return kExitIo;
-  } catch (const fesd::Error& e) {  // InvalidOption, ProblemFileError, ExpressionError, InvalidModel
+  } catch (
+      const fesd::Error& e) {  // InvalidOption, ProblemFileError, ExpressionError, InvalidModel
     print_error(e.what());
     return kExitBadInput;
   } catch (const UsageError& e) {

@@ -20,6 +20,7 @@ namespace fesd {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+constexpr double kActiveThetaTol = 1e-6;
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
@@ -152,14 +153,14 @@ IntegratorResult integrate(const Pss& model, const Eigen::VectorXd& x0_in, doubl
 
     for (int n = 0; n < N_FE; ++n) {
       const double hn = w[iv.h(n)];
+      // Active regions of the element: theta_{n,m,r} > 1e-6 at some stage. theta is a convex
+      // weight in [0, 1]; inactive regions have theta ~ sigma / lambda at the solution, and
+      // lambda alone cannot decide (it vanishes for every region at a switching boundary).
       std::vector<int> active;
       for (int r = 0; r < n_th; ++r) {
-        double th = 0, la = 0;
-        for (int s = 0; s < n_s; ++s) {
-          th += w[iv.theta(n, s, r)];
-          la += w[iv.lambda(n, s, r)];
-        }
-        if (th > la) active.push_back(r);
+        double th = 0;
+        for (int s = 0; s < n_s; ++s) th = std::max(th, w[iv.theta(n, s, r)]);
+        if (th > kActiveThetaTol) active.push_back(r);
       }
       for (int s = 0; s < n_s; ++s) {
         res.t_stage.push_back(t + tab.c(s) * hn);

@@ -20,7 +20,9 @@ namespace {
 using json = nlohmann::ordered_json;
 
 // Non-finite numbers have no JSON spelling: they become null.
-json number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+json number(double v) {
+  return std::isfinite(v) ? json(v) : json(nullptr);
+}
 
 json array(const std::vector<double>& v) {
   json a = json::array();
@@ -42,19 +44,20 @@ json rows(const std::vector<Eigen::VectorXd>& v) {
 }
 
 json stats(const Summary& s) {
-  return json{{"homotopy_steps", s.homotopy_steps},   {"nlp_iterations", s.nlp_iterations},
-              {"wall_s", number(s.wall_s)},           {"derivative_s", number(s.derivative_s)},
-              {"solver_s", number(s.solver_s)},       {"setup_s", number(s.setup_s)},
+  return json{{"homotopy_steps", s.homotopy_steps},
+              {"nlp_iterations", s.nlp_iterations},
+              {"wall_s", number(s.wall_s)},
+              {"derivative_s", number(s.derivative_s)},
+              {"solver_s", number(s.solver_s)},
+              {"setup_s", number(s.setup_s)},
               {"max_comp_residual", number(s.max_comp_residual)}};
 }
 
 json switches(const std::vector<SwitchEvent>& events) {
   json a = json::array();
   for (const SwitchEvent& e : events) {
-    a.push_back(json{{"t", number(e.t)},
-                     {"element", e.element},
-                     {"before", e.before},
-                     {"after", e.after}});
+    a.push_back(
+        json{{"t", number(e.t)}, {"element", e.element}, {"before", e.before}, {"after", e.after}});
   }
   return a;
 }
@@ -96,9 +99,13 @@ void append_number(std::string& out, double v) {
   out += buf;
 }
 
-std::string compact(const json& j) { return j.dump(-1, ' ', false, json::error_handler_t::replace); }
+std::string compact(const json& j) {
+  return j.dump(-1, ' ', false, json::error_handler_t::replace);
+}
 
-bool is_container(const json& j) { return j.is_array() || j.is_object(); }
+bool is_container(const json& j) {
+  return j.is_array() || j.is_object();
+}
 
 // Readable without being huge: the top-level keys one per line, arrays of arrays or objects one
 // element per line (a row of x, a homotopy row), everything else on one line. Invalid UTF-8 in

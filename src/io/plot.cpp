@@ -1,5 +1,6 @@
 // src/io/plot.cpp: plots of an integrator result with gnuplot (PNG or SVG). The data go inline in
-// the script (gnuplot data blocks), the script goes to gnuplot's standard input: no temporary files.
+// the script (gnuplot data blocks), the script goes to gnuplot's standard input: no temporary
+// files.
 //
 // Layout: top panel the states x(t) at the finite-element boundaries, one line per state, with a
 // dashed vertical line at every switching time t_s; bottom panel the step sizes h_n drawn as a
@@ -103,8 +104,7 @@ std::string terminal_for(const std::string& path) {
            "background rgb 'white'\n";
   }
   const std::string shown = ext.empty() ? "no extension" : "extension '" + ext + "'";
-  throw IoError("cannot plot to '" + path + "': unsupported " + shown +
-                " (supported: .png, .svg)");
+  throw IoError("cannot plot to '" + path + "': unsupported " + shown + " (supported: .png, .svg)");
 }
 
 std::string make_script(const IntegratorResult& result, const Pss& model, const std::string& path,
@@ -170,24 +170,26 @@ std::string make_script(const IntegratorResult& result, const Pss& model, const 
   // Top panel: the states.
   s += "set origin 0," + number(0.36) + "\nset size 1," + number(top - 0.36) + "\n";
   s += "set tmargin 2\nset bmargin 1\nset format x ''\nunset xlabel\nset ylabel 'x(t)'\n";
+  s += "set offsets 0, 0, graph 0.05, graph 0.05\n";
   s += "plot ";
   for (std::size_t i = 0; i < n_x; ++i) {
     s += "$states using 1:" + std::to_string(i + 2) + " with lines linewidth 2 title " +
          gp_string(names[i]) + ", ";
   }
   s += ts.empty() ? "NaN notitle\n"
-                  : "NaN with lines dashtype 2 linecolor rgb '#707070' title 'switching times'\n";
+                  : "NaN with lines dashtype 2 linecolor rgb '#707070' title 'switches'\n";
   s += "unset label\n";
 
   // Bottom panel: the step sizes.
   s += "set origin 0,0\nset size 1," + number(0.36) + "\n";
-  s += "set tmargin 0.5\nset bmargin 3.5\nset format x\nset xlabel 't'\n";
+  s += "set tmargin 0.5\nset bmargin 3.5\nset format x\nset xlabel 't'\nset offsets 0, 0, 0, 0\n";
   s += "set ylabel 'h_n' enhanced\n";
   if (n_h == 0 || !(h_max >= h_min)) {
     s += "set yrange [0:1]\nplot NaN notitle\n";
   } else {
     if (h_min > 0 && h_max > 100 * h_min) {
       s += "set logscale y\nset format y '10^{%L}'\n";
+      s += "set yrange [" + number(h_min / 2) + ":" + number(h_max * 2) + "]\n";
     } else if (h_max > h_min) {
       const double pad = 0.1 * (h_max - h_min);
       s += "set yrange [" + number(h_min - pad) + ":" + number(h_max + pad) + "]\n";

@@ -10,6 +10,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -37,8 +38,8 @@ namespace {
 
 constexpr std::array<std::string_view, 7> kTopKeys{
     "name", "description", "model", "simulation", "discretization", "homotopy", "ipopt"};
-constexpr std::array<std::string_view, 9> kModelKeys{"x",  "u", "p", "c",        "S",
-                                                     "F",  "g", "x0", "subsystem"};
+constexpr std::array<std::string_view, 9> kModelKeys{"x", "u", "p",  "c",        "S",
+                                                     "F", "g", "x0", "subsystem"};
 constexpr std::array<std::string_view, 4> kSubsystemKeys{"c", "S", "g", "F"};
 constexpr std::array<std::string_view, 4> kSimulationKeys{"T_sim", "N_sim", "u", "t0"};
 
@@ -163,14 +164,19 @@ int edit_distance(std::string_view a, std::string_view b) {
 
 /// "(did you mean 'n_s'?)" with the nearest valid keys, or "(valid keys: ...)" if none is near.
 std::string key_hint(std::string_view key, std::span<const std::string_view> valid) {
-  // Common names from nosnoc or the paper that differ from the file keys.
-  static constexpr std::array<std::pair<std::string_view, std::string_view>, 6> kAliases{{
+  // nosnoc's names (MATLAB and Python) and the paper's symbols that differ from the file keys.
+  static constexpr std::array<std::pair<std::string_view, std::string_view>, 11> kAliases{{
       {"n_fe", "N_finite_elements"},
       {"max_homotopy_steps", "N_homotopy"},
+      {"max_iter_homotopy", "N_homotopy"},
       {"comp_tol", "complementarity_tol"},
-      {"t_final", "T_sim"},
+      {"terminal_time", "T_sim"},
       {"irk_scheme", "rk_scheme"},
       {"cross_comp", "cross_comp_mode"},
+      {"g_ind", "g"},
+      {"g_indicator", "g"},
+      {"g_stewart", "g"},
+      {"p_global", "p"},
   }};
   const std::string k = lower(key);
   std::vector<std::pair<int, std::string_view>> near;
@@ -179,13 +185,23 @@ std::string key_hint(std::string_view key, std::span<const std::string_view> val
     int d = edit_distance(k, lv);
     for (const auto& [alias, target] : kAliases)
       if (alias == k && target == v) d = 0;
-    if (k.size() >= 3 && (lv.find(k) != std::string::npos || k.find(lv) != std::string::npos))
+    if (k.size() >= 3 && lv.size() >= 3 &&
+        (lv.find(k) != std::string::npos || k.find(lv) != std::string::npos))
       d = std::min(d, 1);
     const int threshold = std::max<int>(1, std::min<int>(3, static_cast<int>(k.size()) / 3 + 1));
     if (d <= threshold) near.emplace_back(d, v);
   }
-  std::stable_sort(near.begin(), near.end(),
-                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  // Only the nearest ones; among equally near keys, those of similar length first.
+  if (!near.empty()) {
+    const int best = std::min_element(near.begin(), near.end())->first;
+    std::erase_if(near, [&](const auto& e) { return e.first > best; });
+  }
+  const auto length_gap = [&](std::string_view v) {
+    return std::abs(static_cast<int>(v.size()) - static_cast<int>(k.size()));
+  };
+  std::stable_sort(near.begin(), near.end(), [&](const auto& a, const auto& b) {
+    return length_gap(a.second) < length_gap(b.second);
+  });
   std::string list;
   if (near.empty()) {
     for (std::string_view v : valid) list += (list.empty() ? "" : ", ") + std::string(v);
@@ -204,7 +220,9 @@ std::string key_hint(std::string_view key, std::span<const std::string_view> val
 std::string join(std::string_view path, std::string_view key) {
   return path.empty() ? std::string(key) : fmt::format("{}.{}", path, key);
 }
-std::string index(std::string_view path, std::size_t i) { return fmt::format("{}[{}]", path, i); }
+std::string index(std::string_view path, std::size_t i) {
+  return fmt::format("{}[{}]", path, i);
+}
 
 std::string describe(const toml::node& n) {
   switch (n.type()) {
@@ -259,7 +277,14 @@ std::vector<std::pair<const toml::key*, const toml::node*>> in_file_order(const 
   return entries;
 }
 
-std::string format_number(double v) { return fmt::format("{}", v); }
+std::string format_number(double v) {
+  return fmt::format("{}", v);
+}
+
+/// "1 number", "2 numbers".
+std::string count(std::size_t n, std::string_view noun) {
+  return fmt::format("{} {}{}", n, noun, n == 1 ? "" : "s");
+}
 
 // ---- the reader -------------------------------------------------------------------------------
 
@@ -339,8 +364,8 @@ class Reader {
     const toml::array& a = array(n, path, "an array of numbers");
     if (expected_length >= 0 && static_cast<int>(a.size()) != expected_length)
       fail(n.source(), path,
-           fmt::format("wrong length (expected {} numbers, {}, got {})", expected_length, what,
-                       a.size()));
+           fmt::format("wrong length (expected {}, {}, got {})",
+                       count(static_cast<std::size_t>(expected_length), "number"), what, a.size()));
     Eigen::VectorXd v(static_cast<Eigen::Index>(a.size()));
     for (std::size_t i = 0; i < a.size(); ++i)
       v[static_cast<Eigen::Index>(i)] = number(a[i], index(path, i));
@@ -350,7 +375,8 @@ class Reader {
                                                                std::string_view path) const {
     const toml::array& a = array(n, path, "an array of names");
     std::vector<std::pair<std::string, const toml::node*>> out;
-    for (std::size_t i = 0; i < a.size(); ++i) out.emplace_back(string(a[i], index(path, i)), &a[i]);
+    for (std::size_t i = 0; i < a.size(); ++i)
+      out.emplace_back(string(a[i], index(path, i)), &a[i]);
     return out;
   }
   /// A string expression (or a plain number) parsed with `symbols`.
@@ -391,7 +417,8 @@ struct RawSubsystem {
   int n_f = 0;
 };
 
-void check_names(const Reader& r, const std::vector<std::pair<std::string, const toml::node*>>& names,
+void check_names(const Reader& r,
+                 const std::vector<std::pair<std::string, const toml::node*>>& names,
                  std::string_view path, std::string_view kind, std::set<std::string>& seen,
                  bool t_allowed) {
   for (std::size_t i = 0; i < names.size(); ++i) {
@@ -546,11 +573,10 @@ bool uses_symbol(const RawSubsystem& s, int index) {
   return std::any_of(s.expressions.F.begin(), s.expressions.F.end(), any);
 }
 
-void read_model(const Reader& r, const toml::table& root, SimulationProblem& problem,
-                double t0) {
+void read_model(const Reader& r, const toml::table& root, SimulationProblem& problem, double t0) {
   const toml::node* model_node = root.get("model");
   if (model_node == nullptr)
-    r.fail(root.source(), "model",
+    r.fail(toml::source_region{}, "model",
            "missing table [model] (expected x, x0, F and either c or g)");
   const toml::table& model = r.table(*model_node, "model");
   r.check_keys(model, kModelKeys, "model");
@@ -560,7 +586,8 @@ void read_model(const Reader& r, const toml::table& root, SimulationProblem& pro
   std::set<std::string> seen;
   const toml::node* x_node = model.get("x");
   if (x_node == nullptr)
-    r.fail(model.source(), "model", "missing key 'x' (expected the state names, e.g. x = [\"x1\"])");
+    r.fail(model.source(), "model",
+           "missing key 'x' (expected the state names, e.g. x = [\"x1\"])");
   const auto x_names = r.names(*x_node, "model.x");
   if (x_names.empty())
     r.fail(x_node->source(), "model.x", "no states (expected at least one state name)");
@@ -572,7 +599,8 @@ void read_model(const Reader& r, const toml::table& root, SimulationProblem& pro
   std::vector<double> p_values;
   if (const toml::node* n = model.get("p")) {
     const toml::table* pt = n->as_table();
-    if (pt == nullptr) r.wrong_type(*n, "model.p", "a table of name = value, e.g. { omega = 6.28 }");
+    if (pt == nullptr)
+      r.wrong_type(*n, "model.p", "a table of name = value, e.g. { omega = 6.28 }");
     for (const auto& [k, v] : in_file_order(*pt)) {
       p_names.emplace_back(k->str(), v);
       p_values.push_back(r.number(*v, join("model.p", k->str())));
@@ -615,10 +643,10 @@ void read_model(const Reader& r, const toml::table& root, SimulationProblem& pro
   }
 
   // The clock: appended if some expression reads t.
-  const bool has_clock =
-      sym.time_index >= 0 &&
-      std::any_of(subsystems.begin(), subsystems.end(),
-                  [&](const RawSubsystem& s) { return uses_symbol(s, sym.time_index); });
+  const bool has_clock = sym.time_index >= 0 && std::any_of(subsystems.begin(), subsystems.end(),
+                                                            [&](const RawSubsystem& s) {
+                                                              return uses_symbol(s, sym.time_index);
+                                                            });
   const int n_x_user = static_cast<int>(sym.x.size());
   const int n_x = n_x_user + (has_clock ? 1 : 0);
   if (has_clock) {
@@ -632,7 +660,8 @@ void read_model(const Reader& r, const toml::table& root, SimulationProblem& pro
   const toml::node* x0_node = model.get("x0");
   if (x0_node == nullptr)
     r.fail(model.source(), "model",
-           fmt::format("missing key 'x0' (expected the initial state, {} numbers)", n_x_user));
+           fmt::format("missing key 'x0' (expected the initial state, {})",
+                       count(static_cast<std::size_t>(n_x_user), "number")));
   Eigen::VectorXd x0 = r.vector(*x0_node, "model.x0", n_x_user, "one per state in x");
   if (has_clock) {
     x0.conservativeResize(n_x);
@@ -733,7 +762,7 @@ void read_options(const Reader& r, const toml::table& root, SimulationProblem& p
     const bool required = table_name == "simulation";
     if (tn == nullptr) {
       if (required)
-        r.fail(root.source(), table_name,
+        r.fail(toml::source_region{}, table_name,
                "missing table [simulation] (expected at least T_sim, the length of the time "
                "interval)");
       continue;
@@ -803,7 +832,8 @@ std::string trim(std::string_view s) {
 
 }  // namespace
 
-SimulationProblem parse_simulation_problem(std::string_view toml_text, std::string_view source_name) {
+SimulationProblem parse_simulation_problem(std::string_view toml_text,
+                                           std::string_view source_name) {
   const Reader r{std::string(source_name)};
   toml::table root;
   try {
@@ -837,7 +867,8 @@ SimulationProblem parse_simulation_problem(std::string_view toml_text, std::stri
   if (const toml::node* sim = root.get("simulation"))
     if (const toml::table* st = sim->as_table())
       if (const toml::node* un = st->get("u"))
-        problem.u = r.vector(*un, "simulation.u", problem.model.n_u(), "one per control in model.u");
+        problem.u =
+            r.vector(*un, "simulation.u", problem.model.n_u(), "one per control in model.u");
 
   read_options(r, root, problem);
   return problem;
@@ -846,9 +877,9 @@ SimulationProblem parse_simulation_problem(std::string_view toml_text, std::stri
 SimulationProblem load_simulation_problem(const std::string& path) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
-    throw ProblemFileError(fmt::format(
-        "{}: cannot read problem file ({})", path,
-        std::filesystem::exists(path, ec) ? "not a regular file" : "no such file"));
+    throw ProblemFileError(
+        fmt::format("{}: cannot read problem file ({})", path,
+                    std::filesystem::exists(path, ec) ? "not a regular file" : "no such file"));
   std::ifstream in(path, std::ios::binary);
   if (!in) throw ProblemFileError(fmt::format("{}: cannot open problem file", path));
   std::ostringstream text;
@@ -857,7 +888,8 @@ SimulationProblem load_simulation_problem(const std::string& path) {
   return parse_simulation_problem(text.str(), path);
 }
 
-void apply_override(SimulationProblem& problem, std::string_view key_in, std::string_view value_in) {
+void apply_override(SimulationProblem& problem, std::string_view key_in,
+                    std::string_view value_in) {
   std::string_view key = key_in;
   while (!key.empty() && key.front() == '-') key.remove_prefix(1);
   const std::string value = trim(value_in);
@@ -902,7 +934,8 @@ void apply_override(SimulationProblem& problem, std::string_view key_in, std::st
         else if (value == "0" || value == "false")
           v.b = false;
         else
-          override_error(head, fmt::format("expected a boolean (1, 0, true or false, got \"{}\")", value));
+          override_error(
+              head, fmt::format("expected a boolean (1, 0, true or false, got \"{}\")", value));
         break;
       default:
         if (auto error = parse_enum(spec->kind, value, v)) override_error(head, *error);
@@ -925,13 +958,15 @@ void apply_override(SimulationProblem& problem, std::string_view key_in, std::st
       rest = comma == std::string_view::npos ? std::string_view{} : rest.substr(comma + 1);
     }
     if (static_cast<int>(u.size()) != updated.model.n_u())
-      override_error(head, fmt::format("wrong length (expected {} numbers, one per control, got {})",
-                       updated.model.n_u(), u.size()));
+      override_error(
+          head,
+          fmt::format("wrong length (expected {}, one per control, got {})",
+                      count(static_cast<std::size_t>(updated.model.n_u()), "number"), u.size()));
     updated.u = Eigen::Map<const Eigen::VectorXd>(u.data(), static_cast<Eigen::Index>(u.size()));
   } else if (table == "ipopt" && !key.empty()) {
     auto& extra = updated.options.nlp.extra;
-    const auto it = std::find_if(extra.begin(), extra.end(),
-                                 [&](const auto& kv) { return kv.first == key; });
+    const auto it =
+        std::find_if(extra.begin(), extra.end(), [&](const auto& kv) { return kv.first == key; });
     if (it != extra.end())
       it->second = value;
     else

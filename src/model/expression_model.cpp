@@ -28,7 +28,8 @@ class SymbolBuffer {
   ~SymbolBuffer() {
     T* d = data();
     std::destroy_n(d, size_);
-    if (heap_ != nullptr) std::allocator<T>().deallocate(heap_, static_cast<std::size_t>(capacity_));
+    if (heap_ != nullptr)
+      std::allocator<T>().deallocate(heap_, static_cast<std::size_t>(capacity_));
   }
   SymbolBuffer(const SymbolBuffer&) = delete;
   SymbolBuffer& operator=(const SymbolBuffer&) = delete;
@@ -63,7 +64,8 @@ int max_dependency(const expr::Expression& e) {
 
 }  // namespace
 
-ExpressionModel::ExpressionModel(ExpressionLayout layout, std::vector<ExpressionSubsystem> subsystems)
+ExpressionModel::ExpressionModel(ExpressionLayout layout,
+                                 std::vector<ExpressionSubsystem> subsystems)
     : layout_(layout) {
   const ExpressionLayout& L = layout_;
   if (L.n_x < 1) throw InvalidModel(fmt::format("expression model: n_x = {}: must be >= 1", L.n_x));
@@ -71,7 +73,8 @@ ExpressionModel::ExpressionModel(ExpressionLayout layout, std::vector<Expression
     throw InvalidModel(fmt::format("expression model: n_x_slots = {}: must be n_x = {} or n_x + 1",
                                    L.n_x_slots, L.n_x));
   if (L.n_u < 0 || L.n_p < 0)
-    throw InvalidModel(fmt::format("expression model: n_u = {}, n_p = {}: must be >= 0", L.n_u, L.n_p));
+    throw InvalidModel(
+        fmt::format("expression model: n_u = {}, n_p = {}: must be >= 0", L.n_u, L.n_p));
   if (subsystems.empty()) throw InvalidModel("expression model: no subsystem given");
 
   const int first_u = L.n_x_slots;
@@ -82,9 +85,10 @@ ExpressionModel::ExpressionModel(ExpressionLayout layout, std::vector<Expression
   };
   const auto check_symbols = [&](const expr::Expression& e, const std::string& what) {
     if (max_dependency(e) >= L.n_symbols())
-      throw InvalidModel(fmt::format("expression model: {} = '{}' reads input {}, but there are "
-                                     "only {} symbols",
-                                     what, e.text(), max_dependency(e), L.n_symbols()));
+      throw InvalidModel(
+          fmt::format("expression model: {} = '{}' reads input {}, but there are "
+                      "only {} symbols",
+                      what, e.text(), max_dependency(e), L.n_symbols()));
   };
 
   for (std::size_t k = 0; k < subsystems.size(); ++k) {
@@ -97,9 +101,10 @@ ExpressionModel::ExpressionModel(ExpressionLayout layout, std::vector<Expression
       for (const expr::Expression& e : list.get()) {
         check_symbols(e, where + " c/g");
         if (reads_control(e))
-          throw InvalidModel(fmt::format("{}: '{}' reads a control; switching and indicator "
-                                         "functions depend on x and p only",
-                                         where, e.text()));
+          throw InvalidModel(
+              fmt::format("{}: '{}' reads a control; switching and indicator "
+                          "functions depend on x and p only",
+                          where, e.text()));
       }
     }
     for (std::size_t i = 0; i < s.F.size(); ++i) {
@@ -129,15 +134,15 @@ void ExpressionModel::eval_list(const std::vector<expr::Expression>& list, const
   for (std::size_t i = 0; i < list.size(); ++i) out[i] = list[i].template evaluate<T>(symbols);
 }
 
-#define FESD_DEFINE_EXPRESSION_FUNCTIONS(T)                                              \
-  void ExpressionModel::c(const T* x, const T* p, T* c_out) const {                     \
-    eval_list<T>(c_, x, nullptr, p, c_out);                                             \
-  }                                                                                     \
-  void ExpressionModel::g(const T* x, const T* p, T* g_out) const {                     \
-    eval_list<T>(g_, x, nullptr, p, g_out);                                             \
-  }                                                                                     \
+#define FESD_DEFINE_EXPRESSION_FUNCTIONS(T)                                                 \
+  void ExpressionModel::c(const T* x, const T* p, T* c_out) const {                         \
+    eval_list<T>(c_, x, nullptr, p, c_out);                                                 \
+  }                                                                                         \
+  void ExpressionModel::g(const T* x, const T* p, T* g_out) const {                         \
+    eval_list<T>(g_, x, nullptr, p, g_out);                                                 \
+  }                                                                                         \
   void ExpressionModel::f(int region, const T* x, const T* u, const T* p, T* f_out) const { \
-    eval_list<T>(fields_.at(static_cast<std::size_t>(region)), x, u, p, f_out);         \
+    eval_list<T>(fields_.at(static_cast<std::size_t>(region)), x, u, p, f_out);             \
   }
 FESD_FOR_EACH_SCALAR(FESD_DEFINE_EXPRESSION_FUNCTIONS)
 #undef FESD_DEFINE_EXPRESSION_FUNCTIONS
@@ -145,9 +150,10 @@ FESD_FOR_EACH_SCALAR(FESD_DEFINE_EXPRESSION_FUNCTIONS)
 Pss make_expression_pss(PssDims dims, ExpressionLayout layout,
                         std::vector<ExpressionSubsystem> subsystems) {
   if (dims.n_x != layout.n_x || dims.n_u != layout.n_u || dims.n_p != layout.n_p)
-    throw InvalidModel(fmt::format("expression model: dims (n_x {}, n_u {}, n_p {}) differ from "
-                                   "the expression layout (n_x {}, n_u {}, n_p {})",
-                                   dims.n_x, dims.n_u, dims.n_p, layout.n_x, layout.n_u, layout.n_p));
+    throw InvalidModel(
+        fmt::format("expression model: dims (n_x {}, n_u {}, n_p {}) differ from "
+                    "the expression layout (n_x {}, n_u {}, n_p {})",
+                    dims.n_x, dims.n_u, dims.n_p, layout.n_x, layout.n_u, layout.n_p));
   if (dims.subsystems.size() != subsystems.size())
     throw InvalidModel(fmt::format("expression model: {} subsystems in dims, {} with expressions",
                                    dims.subsystems.size(), subsystems.size()));
@@ -155,13 +161,15 @@ Pss make_expression_pss(PssDims dims, ExpressionLayout layout,
     const Subsystem& d = dims.subsystems[k];
     const ExpressionSubsystem& s = subsystems[k];
     if (d.n_c != static_cast<int>(s.c.size()) || d.n_g != static_cast<int>(s.g.size()))
-      throw InvalidModel(fmt::format("expression model: subsystem {}: n_c = {}, n_g = {} but {} c "
-                                     "and {} g expressions",
-                                     k, d.n_c, d.n_g, s.c.size(), s.g.size()));
+      throw InvalidModel(
+          fmt::format("expression model: subsystem {}: n_c = {}, n_g = {} but {} c "
+                      "and {} g expressions",
+                      k, d.n_c, d.n_g, s.c.size(), s.g.size()));
     if (d.n_f() != static_cast<int>(s.F.size()))
-      throw InvalidModel(fmt::format("expression model: subsystem {}: {} regions but {} vector "
-                                     "fields F",
-                                     k, d.n_f(), s.F.size()));
+      throw InvalidModel(
+          fmt::format("expression model: subsystem {}: {} regions but {} vector "
+                      "fields F",
+                      k, d.n_f(), s.F.size()));
   }
   auto functions = std::make_shared<const ExpressionModel>(layout, std::move(subsystems));
   return Pss(std::move(dims), std::move(functions));

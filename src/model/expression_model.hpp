@@ -47,9 +47,9 @@ class ExpressionModel final : public PssFunctions {
   const ExpressionLayout& layout() const { return layout_; }
   int n_regions() const { return static_cast<int>(fields_.size()); }
 
-#define FESD_DECLARE_EXPRESSION_FUNCTIONS(T)                                          \
-  void c(const T* x, const T* p, T* c_out) const override;                            \
-  void g(const T* x, const T* p, T* g_out) const override;                            \
+#define FESD_DECLARE_EXPRESSION_FUNCTIONS(T)               \
+  void c(const T* x, const T* p, T* c_out) const override; \
+  void g(const T* x, const T* p, T* g_out) const override; \
   void f(int region, const T* x, const T* u, const T* p, T* f_out) const override;
   FESD_FOR_EACH_SCALAR(FESD_DECLARE_EXPRESSION_FUNCTIONS)
 #undef FESD_DECLARE_EXPRESSION_FUNCTIONS
@@ -60,8 +60,8 @@ class ExpressionModel final : public PssFunctions {
                  T* out) const;
 
   ExpressionLayout layout_;
-  std::vector<expr::Expression> c_;                   // all c-form subsystems' c, concatenated
-  std::vector<expr::Expression> g_;                   // all g-form subsystems' g, concatenated
+  std::vector<expr::Expression> c_;                    // all c-form subsystems' c, concatenated
+  std::vector<expr::Expression> g_;                    // all g-form subsystems' g, concatenated
   std::vector<std::vector<expr::Expression>> fields_;  // one per region over all subsystems
 };
 

@@ -105,18 +105,16 @@ TEST(BadProblemFileIo, DirectoryInsteadOfFile) {
 }
 
 TEST(BadProblemFileText, SyntaxErrorHasLineAndColumn) {
-  const Outcome o = outcome_of([] {
-    parse_simulation_problem("[model]\nx = [\"x1\"]\nx0 = [1.0,, 2.0]\n", "inline.toml");
-  });
+  const Outcome o = outcome_of(
+      [] { parse_simulation_problem("[model]\nx = [\"x1\"]\nx0 = [1.0,, 2.0]\n", "inline.toml"); });
   EXPECT_EQ(o.kind, "ProblemFileError");
   EXPECT_EQ(o.message.rfind("inline.toml:3:", 0), 0U) << o.message;
   EXPECT_NE(o.message.find("TOML syntax error"), std::string::npos) << o.message;
 }
 
 TEST(BadProblemFileText, DuplicateKeyIsASyntaxError) {
-  const Outcome o = outcome_of([] {
-    parse_simulation_problem("[simulation]\nT_sim = 1\nT_sim = 2\n", "dup.toml");
-  });
+  const Outcome o = outcome_of(
+      [] { parse_simulation_problem("[simulation]\nT_sim = 1\nT_sim = 2\n", "dup.toml"); });
   EXPECT_EQ(o.kind, "ProblemFileError");
   EXPECT_EQ(o.message.rfind("dup.toml:3:", 0), 0U) << o.message;
 }
@@ -193,8 +191,7 @@ INSTANTIATE_TEST_SUITE_P(
         OverrideCase{"n_s", "0", "--n_s = 0: must be in 1..9 for radau_iia"},
         OverrideCase{"n_s", "three", "--n_s = three: expected an integer"},
         OverrideCase{"n_s", "2.5", "--n_s = 2.5: expected an integer"},
-        OverrideCase{"N_FE", "1",
-                     "--N_FE = 1: discretization.N_finite_elements = 1: FESD needs >= 2"},
+        OverrideCase{"N_FE", "1", "--N_FE = 1: FESD needs >= 2 finite elements"},
         OverrideCase{"use_fesd", "yes",
                      "--use_fesd = yes: expected a boolean (1, 0, true or false, got \"yes\")"},
         OverrideCase{"rk_scheme", "rk4",
@@ -209,7 +206,7 @@ INSTANTIATE_TEST_SUITE_P(
                      "--sigma_0 = 1e-20: homotopy.sigma_N = 1e-12: must be <= sigma_0"},
         OverrideCase{"print_level", "99", "--print_level = 99: must be in 0..12"},
         OverrideCase{"u", "1, 2",
-                     "--u = 1, 2: wrong length (expected 1 numbers, one per control, got 2)"},
+                     "--u = 1, 2: wrong length (expected 1 number, one per control, got 2)"},
         OverrideCase{"u", "abc", "--u = abc: expected comma-separated numbers"}),
     [](const ::testing::TestParamInfo<OverrideCase>& param_info) {
       return "case" + std::to_string(param_info.index);

@@ -39,8 +39,8 @@ std::vector<double> eval_g_direct(const Pss& m, const Eigen::VectorXd& x,
   return g;
 }
 
-Eigen::VectorXd eval_f(const Pss& m, int region, const Eigen::VectorXd& x,
-                       const Eigen::VectorXd& u, const Eigen::VectorXd& p) {
+Eigen::VectorXd eval_f(const Pss& m, int region, const Eigen::VectorXd& x, const Eigen::VectorXd& u,
+                       const Eigen::VectorXd& p) {
   Eigen::VectorXd f(m.n_x());
   m.functions().f(region, x.data(), u.data(), p.data(), f.data());
   return f;
@@ -160,8 +160,8 @@ TEST_P(ScalarExamples, LoadAsWritten) {
 
 INSTANTIATE_TEST_SUITE_P(
     Example3, ScalarExamples,
-    ::testing::Values(SignExample{"crossing.toml", -1.0, 2.0, 3.0, 1.0},     // 2 - sign(x)
-                      SignExample{"sliding.toml", 0.5, 1.0, 1.0, -1.0},      // -sign(x)
+    ::testing::Values(SignExample{"crossing.toml", -1.0, 2.0, 3.0, 1.0},      // 2 - sign(x)
+                      SignExample{"sliding.toml", 0.5, 1.0, 1.0, -1.0},       // -sign(x)
                       SignExample{"spontaneous.toml", 0.0, 1.0, -1.0, 1.0}),  // sign(x)
     [](const ::testing::TestParamInfo<SignExample>& param_info) {
       std::string n = param_info.param.file;

@@ -1,0 +1,472 @@
+// bench/fig8_accuracy.cpp: Fig. 8 of papers/fesd-filippov.txt (Sect. 4.4) as tables.
+//
+// The nonsmooth oscillator (47) is simulated over [0, pi/2] with N_sim integration steps of
+// N_FE = 2 finite elements each, by the standard time-stepping method (use_fesd = false) and by
+// FESD, for Radau IIA n_s = 1..4, Gauss-Legendre 1..3, Lobatto IIIC 2..4 and explicit RK 1..4.
+// For every run it records E(T) = ||x(T) - x_exact|| and the switching-time error |t_s - 1|, and
+// per method it fits the slope of log E against log h (h = T / N_sim) by least squares through the
+// points with 1e-10 < E < 1e-1: below 1e-10 is round-off (the NLPs are solved to 1e-12), above
+// 1e-1 is pre-asymptotic.
+//
+//   fig8_accuracy [--quick] [--methods radau_iia:3,gauss_legendre] [--N 8,16,32]
+//                 [--mode both|fesd|std] [--comp-tol 1e-12] [--sigma-N 1e-13] [--ipopt-tol 1e-12]
+//                 [--csv FILE] [--json FILE]
+//
+// A method is `scheme:n_s` or just `scheme` (all n_s of Fig. 8); scheme names as in problem files.
+// One progress line per run goes to stderr; the tables go to stdout.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <fesd/error.hpp>
+#include <fesd/integrator.hpp>
+#include <fesd/options.hpp>
+#include <fesd/tableau.hpp>
+
+#include "oscillator_model.hpp"
+
+namespace {
+
+using fesd::RkScheme;
+
+constexpr double kFitLow = 1e-10;  // below: round-off of NLPs solved to tol = 1e-12
+constexpr double kFitHigh = 1e-1;  // above: pre-asymptotic (h too large)
+
+struct Method {
+  RkScheme scheme = RkScheme::RadauIIA;
+  int n_s = 1;
+  int order = 0;      // classical order for smooth ODEs
+  std::string label;  // short column label, e.g. "Radau3"
+  std::string name;   // e.g. "Radau IIA n_s=3"
+};
+
+Method make_method(RkScheme scheme, int n_s) {
+  Method m;
+  m.scheme = scheme;
+  m.n_s = n_s;
+  m.order = fesd::make_tableau(scheme, n_s).order;
+  switch (scheme) {
+    case RkScheme::RadauIIA: m.label = "Radau"; m.name = "Radau IIA"; break;
+    case RkScheme::GaussLegendre: m.label = "Gauss"; m.name = "Gauss-Legendre"; break;
+    case RkScheme::LobattoIIIA: m.label = "LobA"; m.name = "Lobatto IIIA"; break;
+    case RkScheme::LobattoIIIC: m.label = "LobC"; m.name = "Lobatto IIIC"; break;
+    case RkScheme::ExplicitRK: m.label = "ERK"; m.name = "explicit RK"; break;
+  }
+  m.label += std::to_string(n_s);
+  m.name += fmt::format(" n_s={}", n_s);
+  return m;
+}
+
+/// The n_s values Fig. 8 shows for a scheme.
+std::vector<int> fig8_stages(RkScheme s) {
+  switch (s) {
+    case RkScheme::RadauIIA: return {1, 2, 3, 4};
+    case RkScheme::GaussLegendre: return {1, 2, 3};
+    case RkScheme::LobattoIIIA:
+    case RkScheme::LobattoIIIC: return {2, 3, 4};
+    case RkScheme::ExplicitRK: return {1, 2, 3, 4};
+  }
+  return {};
+}
+
+struct Run {
+  const Method* method = nullptr;
+  bool fesd = false;
+  int N_sim = 0;
+  double h = 0;
+  fesd_bench::OscillatorErrors err;
+  fesd::Status status = fesd::Status::NotRun;
+  std::string message;
+  double wall_s = 0;
+  int nlps = 0;
+  int iterations = 0;
+  double max_comp = 0;
+  bool ok() const { return status == fesd::Status::Success; }
+};
+
+struct Fit {
+  std::optional<double> slope;
+  int points = 0;
+  std::vector<double> local;  // slopes between consecutive points of the window
+};
+
+/// Least-squares slope of log y against log h through the points with kFitLow < y < kFitHigh.
+Fit fit_slope(const std::vector<std::pair<double, double>>& h_y) {
+  std::vector<std::pair<double, double>> pts;
+  for (const auto& [h, y] : h_y)
+    if (std::isfinite(y) && y > kFitLow && y < kFitHigh) pts.emplace_back(std::log(h), std::log(y));
+  std::sort(pts.begin(), pts.end());
+  Fit f;
+  f.points = static_cast<int>(pts.size());
+  for (std::size_t i = 1; i < pts.size(); ++i)
+    f.local.push_back((pts[i].second - pts[i - 1].second) / (pts[i].first - pts[i - 1].first));
+  if (pts.size() < 2) return f;
+  double mx = 0, my = 0;
+  for (const auto& [x, y] : pts) {
+    mx += x;
+    my += y;
+  }
+  const double n = static_cast<double>(pts.size());
+  mx /= n;
+  my /= n;
+  double sxy = 0, sxx = 0;
+  for (const auto& [x, y] : pts) {
+    sxy += (x - mx) * (y - my);
+    sxx += (x - mx) * (x - mx);
+  }
+  f.slope = sxy / sxx;
+  return f;
+}
+
+std::string fmt_opt(const std::optional<double>& v, const char* spec = "{:.2f}") {
+  return v ? fmt::format(fmt::runtime(spec), *v) : std::string("-");
+}
+
+std::vector<std::string> split(std::string_view s, char sep) {
+  std::vector<std::string> out;
+  std::string cur;
+  for (char ch : s) {
+    if (ch == sep) {
+      if (!cur.empty()) out.push_back(cur);
+      cur.clear();
+    } else {
+      cur += ch;
+    }
+  }
+  if (!cur.empty()) out.push_back(cur);
+  return out;
+}
+
+[[noreturn]] void usage(const std::string& why) {
+  std::fprintf(stderr,
+               "fig8_accuracy: %s\n"
+               "usage: fig8_accuracy [--quick] [--methods scheme[:n_s],...] [--N n1,n2,...]\n"
+               "                     [--mode both|fesd|std] [--comp-tol X] [--sigma-N X]\n"
+               "                     [--ipopt-tol X] [--csv FILE] [--json FILE]\n"
+               "schemes: radau_iia gauss_legendre lobatto_iiia lobatto_iiic explicit_rk\n",
+               why.c_str());
+  std::exit(2);
+}
+
+double parse_double(const std::string& flag, const std::string& v) {
+  try {
+    std::size_t pos = 0;
+    const double d = std::stod(v, &pos);
+    if (pos != v.size() || !(d > 0)) throw std::invalid_argument(v);
+    return d;
+  } catch (const std::exception&) {
+    usage(fmt::format("{} {}: expected a positive number", flag, v));
+  }
+}
+
+int parse_int(const std::string& flag, const std::string& v) {
+  try {
+    std::size_t pos = 0;
+    const int i = std::stoi(v, &pos);
+    if (pos != v.size() || i < 1) throw std::invalid_argument(v);
+    return i;
+  } catch (const std::exception&) {
+    usage(fmt::format("{} {}: expected a positive integer", flag, v));
+  }
+}
+
+struct Config {
+  std::vector<Method> methods;
+  std::vector<int> N;
+  bool run_std = true, run_fesd = true;
+  double comp_tol = 1e-12, sigma_N = 1e-13, ipopt_tol = 1e-12;
+  std::string csv, json;
+  bool quick = false;
+};
+
+Config parse_args(int argc, char** argv) {
+  Config cfg;
+  std::string methods_arg, N_arg;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc) usage(a + ": missing value");
+      return argv[++i];
+    };
+    if (a == "--quick") {
+      cfg.quick = true;
+    } else if (a == "--methods") {
+      methods_arg = value();
+    } else if (a == "--N") {
+      N_arg = value();
+    } else if (a == "--mode") {
+      const std::string m = value();
+      if (m == "both") {
+        cfg.run_std = cfg.run_fesd = true;
+      } else if (m == "fesd") {
+        cfg.run_std = false;
+      } else if (m == "std") {
+        cfg.run_fesd = false;
+      } else {
+        usage("--mode " + m + ": expected both, fesd or std");
+      }
+    } else if (a == "--comp-tol") {
+      cfg.comp_tol = parse_double(a, value());
+    } else if (a == "--sigma-N") {
+      cfg.sigma_N = parse_double(a, value());
+    } else if (a == "--ipopt-tol") {
+      cfg.ipopt_tol = parse_double(a, value());
+    } else if (a == "--csv") {
+      cfg.csv = value();
+    } else if (a == "--json") {
+      cfg.json = value();
+    } else if (a == "-h" || a == "--help") {
+      usage("help");
+    } else {
+      usage("unknown argument " + a);
+    }
+  }
+  if (N_arg.empty()) {
+    cfg.N = cfg.quick ? std::vector<int>{8, 16, 32} : std::vector<int>{8, 11, 16, 23, 32, 45, 64};
+  } else {
+    for (const std::string& s : split(N_arg, ',')) cfg.N.push_back(parse_int("--N", s));
+  }
+  std::sort(cfg.N.begin(), cfg.N.end());
+  cfg.N.erase(std::unique(cfg.N.begin(), cfg.N.end()), cfg.N.end());
+
+  if (methods_arg.empty())
+    methods_arg = cfg.quick ? "radau_iia:2,radau_iia:3,gauss_legendre:2,lobatto_iiic:3,explicit_rk:4"
+                            : "radau_iia,gauss_legendre,lobatto_iiic,explicit_rk";
+  for (const std::string& item : split(methods_arg, ',')) {
+    const auto colon = item.find(':');
+    const std::string name = item.substr(0, colon);
+    RkScheme scheme{};
+    if (!fesd::parse(name, scheme)) usage("unknown scheme " + name);
+    std::vector<int> stages;
+    if (colon == std::string::npos)
+      stages = fig8_stages(scheme);
+    else
+      stages.push_back(parse_int("--methods", item.substr(colon + 1)));
+    for (int n_s : stages) {
+      try {
+        cfg.methods.push_back(make_method(scheme, n_s));
+      } catch (const fesd::Error& e) {
+        usage(item + ": " + e.what());
+      }
+    }
+  }
+  return cfg;
+}
+
+Run run_one(const Method& m, bool use_fesd, int N_sim, const Config& cfg) {
+  fesd::IntegratorOptions opt;
+  opt.discretization.rk_scheme = m.scheme;
+  opt.discretization.n_s = m.n_s;
+  opt.discretization.N_FE = 2;  // as in the paper
+  opt.discretization.use_fesd = use_fesd;
+  opt.homotopy.complementarity_tol = cfg.comp_tol;
+  opt.homotopy.sigma_N = cfg.sigma_N;
+  opt.nlp.tol = cfg.ipopt_tol;
+  Run r;
+  r.method = &m;
+  r.fesd = use_fesd;
+  r.N_sim = N_sim;
+  r.h = fesd_bench::kOscillatorT / N_sim;
+  static const fesd::Pss model = fesd_bench::oscillator_model();
+  try {
+    const fesd::IntegratorResult res = fesd::integrate(model, fesd_bench::oscillator_x0(),
+                                                       fesd_bench::kOscillatorT, N_sim, opt);
+    r.status = res.status;
+    r.message = res.message;
+    r.err = fesd_bench::oscillator_errors(res);
+    r.wall_s = res.summary.wall_s;
+    r.nlps = res.summary.homotopy_steps;
+    r.iterations = res.summary.nlp_iterations;
+    r.max_comp = res.summary.max_comp_residual;
+  } catch (const fesd::Error& e) {
+    r.status = fesd::Status::NotRun;
+    r.message = e.what();
+  }
+  return r;
+}
+
+/// Table cell for an error: value, "-" if absent, "FAIL" if the run did not finish. A '*' marks a
+/// run that detected a number of switches other than one.
+std::string cell(const Run& r, bool t_s) {
+  if (!r.ok()) return "FAIL";
+  if (t_s) {
+    if (!r.err.t_s) return "-";
+    return fmt::format("{:.1e}{}", *r.err.t_s, r.err.n_switches == 1 ? "" : "*");
+  }
+  return fmt::format("{:.1e}", r.err.x_T);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const Config cfg = parse_args(argc, argv);
+  std::vector<bool> modes;
+  if (cfg.run_std) modes.push_back(false);
+  if (cfg.run_fesd) modes.push_back(true);
+
+  // runs[method][mode][N]
+  std::vector<std::vector<std::vector<Run>>> runs(cfg.methods.size());
+  const std::size_t total = cfg.methods.size() * modes.size() * cfg.N.size();
+  std::size_t done = 0;
+  double total_wall = 0;
+  for (std::size_t mi = 0; mi < cfg.methods.size(); ++mi) {
+    for (bool f : modes) {
+      runs[mi].emplace_back();
+      for (int N : cfg.N) {
+        const Run r = run_one(cfg.methods[mi], f, N, cfg);
+        ++done;
+        total_wall += r.wall_s;
+        std::fprintf(stderr,
+                     "[%3zu/%zu] %-20s %-4s N_sim=%-3d E=%.2e  |t_s-1|=%-9s sw=%d  NLPs %4d  "
+                     "iter %5d  %7.2f s  %s\n",
+                     done, total, cfg.methods[mi].name.c_str(), f ? "FESD" : "std", N, r.err.x_T,
+                     fmt_opt(r.err.t_s, "{:.2e}").c_str(), r.err.n_switches, r.nlps, r.iterations,
+                     r.wall_s, r.ok() ? "ok" : (std::string(to_string(r.status)) + ": " + r.message).c_str());
+        runs[mi].back().push_back(r);
+      }
+    }
+  }
+
+  fmt::print("Fig. 8: nonsmooth oscillator (47), T = pi/2, N_FE = 2, h = T/N_sim\n");
+  fmt::print("IPOPT tol {:.0e}, complementarity_tol {:.0e}, sigma_N {:.0e}; fit window {:.0e} < E < {:.0e}\n",
+             cfg.ipopt_tol, cfg.comp_tol, cfg.sigma_N, kFitLow, kFitHigh);
+  fmt::print("FAIL = status not success; '-' = no switch detected; '*' = more than one switch detected\n");
+
+  // ---- error tables: rows N_sim, columns methods ----
+  for (std::size_t k = 0; k < modes.size(); ++k) {
+    for (bool t_s : {false, true}) {
+      fmt::print("\n{} {}\n", modes[k] ? "FESD" : "Standard", t_s ? "|t_s - 1|" : "E(T) = ||x(T) - x_exact||");
+      std::string head = fmt::format("{:>5} {:>8}", "N_sim", "h");
+      for (const Method& m : cfg.methods) head += fmt::format(" {:>9}", m.label);
+      fmt::print("{}\n", head);
+      for (std::size_t j = 0; j < cfg.N.size(); ++j) {
+        std::string line = fmt::format("{:>5} {:>8.4f}", cfg.N[j], fesd_bench::kOscillatorT / cfg.N[j]);
+        for (std::size_t mi = 0; mi < cfg.methods.size(); ++mi)
+          line += fmt::format(" {:>9}", cell(runs[mi][k][j], t_s));
+        fmt::print("{}\n", line);
+      }
+    }
+  }
+
+  // ---- summary: fitted slopes ----
+  nlohmann::json jsum = nlohmann::json::array();
+  fmt::print("\nSlopes of log E against log h (least squares, {:.0e} < E < {:.0e}; (k) = points used)\n",
+             kFitLow, kFitHigh);
+  fmt::print("{:<22} {:>5} {:>10} {:>10} {:>9} {:>10} {:>10}  {:<26} {:>8}\n", "method", "order",
+             "std", "FESD", "FESD-ord", "t_s FESD", "t_s std", "FESD local slopes", "wall s");
+  for (std::size_t mi = 0; mi < cfg.methods.size(); ++mi) {
+    const Method& m = cfg.methods[mi];
+    std::optional<Fit> fx[2], ft[2];
+    double wall = 0;
+    int failures = 0;
+    for (std::size_t k = 0; k < modes.size(); ++k) {
+      std::vector<std::pair<double, double>> ex, et;
+      for (const Run& r : runs[mi][k]) {
+        wall += r.wall_s;
+        if (!r.ok()) {
+          ++failures;
+          continue;
+        }
+        ex.emplace_back(r.h, r.err.x_T);
+        if (r.err.t_s) et.emplace_back(r.h, *r.err.t_s);
+      }
+      fx[modes[k] ? 1 : 0] = fit_slope(ex);
+      ft[modes[k] ? 1 : 0] = fit_slope(et);
+    }
+    auto slope = [](const std::optional<Fit>& f) {
+      if (!f || !f->slope) return std::string("-");
+      return fmt::format("{:.2f} ({})", *f->slope, f->points);
+    };
+    std::optional<double> diff;
+    if (fx[1] && fx[1]->slope) diff = *fx[1]->slope - m.order;
+    std::string local;
+    if (fx[1])
+      for (double s : fx[1]->local) local += fmt::format("{}{:.1f}", local.empty() ? "" : " ", s);
+    fmt::print("{:<22} {:>5} {:>10} {:>10} {:>9} {:>10} {:>10}  {:<26} {:>8.1f}{}\n", m.name, m.order,
+               slope(fx[0]), slope(fx[1]), fmt_opt(diff, "{:+.2f}"), slope(ft[1]), slope(ft[0]),
+               local.empty() ? "-" : local, wall,
+               failures ? fmt::format("  ({} failed run{})", failures, failures == 1 ? "" : "s") : "");
+    auto jfit = [](const std::optional<Fit>& f) -> nlohmann::json {
+      if (!f) return nullptr;
+      nlohmann::json j;
+      j["slope"] = f->slope ? nlohmann::json(*f->slope) : nlohmann::json(nullptr);
+      j["points"] = f->points;
+      j["local_slopes"] = f->local;
+      return j;
+    };
+    jsum.push_back({{"method", m.name},
+                    {"rk_scheme", std::string(fesd::to_string(m.scheme))},
+                    {"n_s", m.n_s},
+                    {"order", m.order},
+                    {"std_error", jfit(fx[0])},
+                    {"fesd_error", jfit(fx[1])},
+                    {"std_t_s", jfit(ft[0])},
+                    {"fesd_t_s", jfit(ft[1])},
+                    {"failed_runs", failures},
+                    {"wall_s", wall}});
+  }
+  fmt::print("\ntotal integration wall time {:.1f} s over {} runs\n", total_wall, total);
+
+  // ---- files ----
+  if (!cfg.csv.empty()) {
+    std::ofstream os(cfg.csv);
+    if (!os) {
+      std::fprintf(stderr, "fig8_accuracy: cannot write %s\n", cfg.csv.c_str());
+      return 1;
+    }
+    os << "method,rk_scheme,n_s,order,use_fesd,N_sim,h,error_x,error_t_s,n_switches,status,wall_s,"
+          "nlps,ipopt_iterations,max_comp_residual\n";
+    for (std::size_t mi = 0; mi < cfg.methods.size(); ++mi)
+      for (const auto& mode_runs : runs[mi])
+        for (const Run& r : mode_runs)
+          os << fmt::format("{},{},{},{},{},{},{:.17g},{:.17g},{},{},{},{:.4f},{},{},{:.3e}\n",
+                            r.method->name, fesd::to_string(r.method->scheme), r.method->n_s,
+                            r.method->order, r.fesd ? 1 : 0, r.N_sim, r.h, r.err.x_T,
+                            r.err.t_s ? fmt::format("{:.17g}", *r.err.t_s) : "", r.err.n_switches,
+                            fesd::to_string(r.status), r.wall_s, r.nlps, r.iterations, r.max_comp);
+  }
+  if (!cfg.json.empty()) {
+    nlohmann::json j;
+    j["problem"] = "oscillator (47), T = pi/2, N_FE = 2";
+    j["options"] = {{"ipopt_tol", cfg.ipopt_tol},
+                    {"complementarity_tol", cfg.comp_tol},
+                    {"sigma_N", cfg.sigma_N},
+                    {"fit_window", {kFitLow, kFitHigh}}};
+    nlohmann::json jr = nlohmann::json::array();
+    for (std::size_t mi = 0; mi < cfg.methods.size(); ++mi)
+      for (const auto& mode_runs : runs[mi])
+        for (const Run& r : mode_runs)
+          jr.push_back({{"method", r.method->name},
+                        {"use_fesd", r.fesd},
+                        {"N_sim", r.N_sim},
+                        {"h", r.h},
+                        {"error_x", r.ok() ? nlohmann::json(r.err.x_T) : nlohmann::json(nullptr)},
+                        {"error_t_s", r.err.t_s ? nlohmann::json(*r.err.t_s) : nlohmann::json(nullptr)},
+                        {"n_switches", r.err.n_switches},
+                        {"status", std::string(fesd::to_string(r.status))},
+                        {"message", r.message},
+                        {"wall_s", r.wall_s},
+                        {"nlps", r.nlps},
+                        {"ipopt_iterations", r.iterations},
+                        {"max_comp_residual", r.max_comp}});
+    j["runs"] = jr;
+    j["summary"] = jsum;
+    std::ofstream os(cfg.json);
+    if (!os) {
+      std::fprintf(stderr, "fig8_accuracy: cannot write %s\n", cfg.json.c_str());
+      return 1;
+    }
+    os << j.dump(2) << "\n";
+  }
+  return 0;
+}

@@ -1,0 +1,253 @@
+// tests/io/cli_test.cpp: the `fesd` program (FESD_CLI) run as a child process: exit codes, the
+// one-line error messages, and the outputs of a short real simulation.
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kOscillator = FESD_SOURCE_DIR "/examples/oscillator.toml";
+
+class TempDir {
+ public:
+  TempDir() {
+    std::random_device rd;
+    path_ = fs::temp_directory_path() /
+            ("fesd_cli_test_" + std::to_string(rd()) + "_" + std::to_string(rd()));
+    fs::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  std::string file(const std::string& name) const { return (path_ / name).string(); }
+
+ private:
+  fs::path path_;
+};
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+std::string shell_quote(const std::string& s) {
+  std::string out = "'";
+  for (char ch : s) {
+    if (ch == '\'') {
+      out += "'\\''";
+    } else {
+      out += ch;
+    }
+  }
+  return out + "'";
+}
+
+struct CliRun {
+  int code = -1;
+  std::string out, err;
+  int err_lines() const { return static_cast<int>(std::count(err.begin(), err.end(), '\n')); }
+};
+
+// Runs FESD_CLI with `args`, capturing stdout and stderr.
+CliRun run_cli(const std::vector<std::string>& args) {
+  TempDir dir;
+  std::string cmd = shell_quote(FESD_CLI);
+  for (const std::string& a : args) {
+    cmd += ' ';
+    cmd += shell_quote(a);
+  }
+  cmd += " >";
+  cmd += shell_quote(dir.file("out"));
+  cmd += " 2>";
+  cmd += shell_quote(dir.file("err"));
+  cmd += " </dev/null";
+  const int status = std::system(cmd.c_str());
+  CliRun r;
+  r.code = status != -1 && WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = read_file(dir.file("out"));
+  r.err = read_file(dir.file("err"));
+  return r;
+}
+
+bool contains(const std::string& haystack, const std::string& needle) {
+  return haystack.find(needle) != std::string::npos;
+}
+
+TEST(Cli, NoArgumentsPrintsHelpAndExits2) {
+  const CliRun r = run_cli({});
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_TRUE(contains(r.out, "simulate")) << r.out;
+  EXPECT_TRUE(contains(r.err, "fesd: error: ")) << r.err;
+  EXPECT_EQ(r.err_lines(), 1) << r.err;
+}
+
+TEST(Cli, HelpAndVersionExit0) {
+  const CliRun help = run_cli({"--help"});
+  EXPECT_EQ(help.code, 0) << help.err;
+  EXPECT_TRUE(contains(help.out, "check")) << help.out;
+  const CliRun sim_help = run_cli({"simulate", "--help"});
+  EXPECT_EQ(sim_help.code, 0) << sim_help.err;
+  EXPECT_TRUE(contains(sim_help.out, "--N_FE")) << sim_help.out;
+  const CliRun version = run_cli({"--version"});
+  EXPECT_EQ(version.code, 0) << version.err;
+  EXPECT_TRUE(contains(version.out, "fesd ")) << version.out;
+}
+
+TEST(Cli, UnknownCommandExits2) {
+  const CliRun r = run_cli({"frobnicate", "x.toml"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_TRUE(contains(r.err, "fesd: error: ")) << r.err;
+  EXPECT_TRUE(contains(r.err, "frobnicate")) << r.err;
+  EXPECT_EQ(r.err_lines(), 1) << r.err;
+}
+
+TEST(Cli, UnknownOptionExits2) {
+  const CliRun r = run_cli({"simulate", kOscillator, "--no_such_option", "1"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_TRUE(contains(r.err, "--no_such_option")) << r.err;
+  EXPECT_EQ(r.err_lines(), 1) << r.err;
+}
+
+TEST(Cli, MissingFileExits2WithThePath) {
+  const std::string path = "/nonexistent/dir/problem.toml";
+  for (const char* command : {"simulate", "check"}) {
+    const CliRun r = run_cli({command, path});
+    EXPECT_EQ(r.code, 2) << command;
+    EXPECT_TRUE(contains(r.err, "fesd: error: ")) << r.err;
+    EXPECT_TRUE(contains(r.err, path)) << r.err;
+    EXPECT_EQ(r.err_lines(), 1) << r.err;
+  }
+}
+
+TEST(Cli, CheckExample) {
+  ASSERT_TRUE(fs::exists(kOscillator)) << kOscillator << " is missing";
+  const CliRun r = run_cli({"check", kOscillator});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(contains(r.out, "oscillator")) << r.out;
+  EXPECT_TRUE(contains(r.out, "n_x = 2")) << r.out;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+}
+
+TEST(Cli, BadOverrideExits2NamingTheKey) {
+  ASSERT_TRUE(fs::exists(kOscillator)) << kOscillator << " is missing";
+  for (const char* command : {"simulate", "check"}) {
+    const CliRun r = run_cli({command, kOscillator, "--n_s", "0"});
+    EXPECT_EQ(r.code, 2) << command;
+    EXPECT_TRUE(contains(r.err, "fesd: error: ")) << r.err;
+    EXPECT_TRUE(contains(r.err, "n_s")) << r.err;
+    EXPECT_EQ(r.err_lines(), 1) << r.err;
+  }
+  const CliRun scheme = run_cli({"check", kOscillator, "--rk_scheme", "runge_kutta_fehlberg"});
+  EXPECT_EQ(scheme.code, 2);
+  EXPECT_TRUE(contains(scheme.err, "rk_scheme")) << scheme.err;
+  const CliRun ipopt = run_cli({"check", kOscillator, "--ipopt", "no_equals_sign"});
+  EXPECT_EQ(ipopt.code, 2);
+  EXPECT_TRUE(contains(ipopt.err, "--ipopt")) << ipopt.err;
+}
+
+TEST(Cli, OverridesAreApplied) {
+  ASSERT_TRUE(fs::exists(kOscillator)) << kOscillator << " is missing";
+  const CliRun r = run_cli({"check", kOscillator, "--N_FE", "3", "--n_s", "2", "--rk_scheme",
+                            "gauss_legendre", "--N_sim", "7", "--ipopt", "mu_strategy=monotone"});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(contains(r.out, "gauss_legendre, n_s = 2, N_FE = 3")) << r.out;
+  EXPECT_TRUE(contains(r.out, "N_sim = 7")) << r.out;
+  EXPECT_TRUE(contains(r.out, "mu_strategy = monotone")) << r.out;
+
+  // Valid only together: N_FE = 1 needs use_fesd = 0, whatever the order on the command line.
+  const CliRun both = run_cli({"check", kOscillator, "--N_FE", "1", "--use_fesd", "0"});
+  EXPECT_EQ(both.code, 0) << both.err;
+  EXPECT_TRUE(contains(both.out, "N_FE = 1, use_fesd = 0")) << both.out;
+  const CliRun alone = run_cli({"check", kOscillator, "--N_FE", "1"});
+  EXPECT_EQ(alone.code, 2);
+  EXPECT_TRUE(contains(alone.err, "N_finite_elements")) << alone.err;
+}
+
+TEST(Cli, BadPlotExtensionExits2BeforeSolving) {
+  ASSERT_TRUE(fs::exists(kOscillator)) << kOscillator << " is missing";
+  TempDir dir;
+  const CliRun r = run_cli({"simulate", kOscillator, "--plot", dir.file("x.pdf")});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_TRUE(contains(r.err, ".pdf")) << r.err;
+  EXPECT_EQ(r.err_lines(), 1) << r.err;
+  EXPECT_FALSE(fs::exists(dir.file("x.pdf")));
+}
+
+TEST(Cli, UnwritableOutputExits3) {
+  // Output paths are checked before solving, so this needs no solve.
+  ASSERT_TRUE(fs::exists(kOscillator)) << kOscillator << " is missing";
+  const std::string path = "/nonexistent/dir/x.json";
+  const CliRun r = run_cli({"simulate", kOscillator, "--json", path});
+  EXPECT_EQ(r.code, 3);
+  EXPECT_TRUE(contains(r.err, "fesd: error: ")) << r.err;
+  EXPECT_TRUE(contains(r.err, path)) << r.err;
+  EXPECT_EQ(r.err_lines(), 1) << r.err;
+}
+
+// REAL SOLVE: a short simulation of the oscillator (2 steps up to t = 0.1, well before its switch
+// at t = 1), well under a second.
+TEST(Cli, SimulateWritesRequestedOutputs) {
+  ASSERT_TRUE(fs::exists(kOscillator)) << kOscillator << " is missing";
+  TempDir dir;
+  const std::string json = dir.file("r.json"), csv = dir.file("r.csv");
+  const CliRun r = run_cli({"simulate", kOscillator, "--N_sim", "2", "--T_sim", "0.1", "--N_FE",
+                            "2", "--json", json, "--csv", csv, "--quiet"});
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_TRUE(r.err.empty()) << "--quiet prints nothing to stderr: " << r.err;
+  EXPECT_TRUE(contains(r.out, json)) << r.out;
+  EXPECT_TRUE(contains(r.out, csv)) << r.out;
+
+  const nlohmann::json j = nlohmann::json::parse(read_file(json));
+  EXPECT_EQ(j["status"], "success");
+  EXPECT_EQ(j["t"].size(), 5u);
+  EXPECT_DOUBLE_EQ(j["t"].back().get<double>(), 0.1);
+  EXPECT_EQ(j["state_names"].get<std::vector<std::string>>(),
+            (std::vector<std::string>{"x1", "x2"}));
+
+  const std::string text = read_file(csv);
+  EXPECT_EQ(text.substr(0, 9), "t,x1,x2\n0");
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 6);  // header + 5 boundaries
+}
+
+// REAL SOLVE: one IPOPT iteration per NLP cannot converge: exit 1, and the outputs are written.
+TEST(Cli, NumericalFailureExits1AndStillWrites) {
+  ASSERT_TRUE(fs::exists(kOscillator)) << kOscillator << " is missing";
+  TempDir dir;
+  const std::string json = dir.file("failed.json");
+  const CliRun r = run_cli({"simulate", kOscillator, "--N_sim", "2", "--T_sim", "0.1", "--max_iter",
+                            "1", "--json", json, "--quiet"});
+  EXPECT_EQ(r.code, 1) << r.out << r.err;
+  EXPECT_EQ(r.err_lines(), 1) << r.err;
+  EXPECT_TRUE(contains(r.err, "fesd: error: ")) << r.err;
+  ASSERT_TRUE(fs::exists(json));
+  const nlohmann::json j = nlohmann::json::parse(read_file(json));
+  EXPECT_NE(j["status"], "success");
+}
+
+// REAL SOLVE (one short step), run in an empty working directory.
+TEST(Cli, NothingWrittenUnlessAsked) {
+  ASSERT_TRUE(fs::exists(kOscillator)) << kOscillator << " is missing";
+  TempDir dir;
+  const std::string cmd = "cd " + shell_quote(dir.file("")) + " && " + shell_quote(FESD_CLI) +
+                          " simulate " + shell_quote(kOscillator) +
+                          " --N_sim 1 --T_sim 0.05 >/dev/null 2>&1";
+  EXPECT_EQ(std::system(cmd.c_str()), 0);
+  EXPECT_TRUE(fs::is_empty(dir.file("")));
+}
+
+}  // namespace
