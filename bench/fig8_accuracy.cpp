@@ -56,11 +56,26 @@ Method make_method(RkScheme scheme, int n_s) {
   m.n_s = n_s;
   m.order = fesd::make_tableau(scheme, n_s).order;
   switch (scheme) {
-    case RkScheme::RadauIIA: m.label = "Radau"; m.name = "Radau IIA"; break;
-    case RkScheme::GaussLegendre: m.label = "Gauss"; m.name = "Gauss-Legendre"; break;
-    case RkScheme::LobattoIIIA: m.label = "LobA"; m.name = "Lobatto IIIA"; break;
-    case RkScheme::LobattoIIIC: m.label = "LobC"; m.name = "Lobatto IIIC"; break;
-    case RkScheme::ExplicitRK: m.label = "ERK"; m.name = "explicit RK"; break;
+    case RkScheme::RadauIIA:
+      m.label = "Radau";
+      m.name = "Radau IIA";
+      break;
+    case RkScheme::GaussLegendre:
+      m.label = "Gauss";
+      m.name = "Gauss-Legendre";
+      break;
+    case RkScheme::LobattoIIIA:
+      m.label = "LobA";
+      m.name = "Lobatto IIIA";
+      break;
+    case RkScheme::LobattoIIIC:
+      m.label = "LobC";
+      m.name = "Lobatto IIIC";
+      break;
+    case RkScheme::ExplicitRK:
+      m.label = "ERK";
+      m.name = "explicit RK";
+      break;
   }
   m.label += std::to_string(n_s);
   m.name += fmt::format(" n_s={}", n_s);
@@ -70,11 +85,15 @@ Method make_method(RkScheme scheme, int n_s) {
 /// The n_s values Fig. 8 shows for a scheme.
 std::vector<int> fig8_stages(RkScheme s) {
   switch (s) {
-    case RkScheme::RadauIIA: return {1, 2, 3, 4};
-    case RkScheme::GaussLegendre: return {1, 2, 3};
+    case RkScheme::RadauIIA:
+      return {1, 2, 3, 4};
+    case RkScheme::GaussLegendre:
+      return {1, 2, 3};
     case RkScheme::LobattoIIIA:
-    case RkScheme::LobattoIIIC: return {2, 3, 4};
-    case RkScheme::ExplicitRK: return {1, 2, 3, 4};
+    case RkScheme::LobattoIIIC:
+      return {2, 3, 4};
+    case RkScheme::ExplicitRK:
+      return {1, 2, 3, 4};
   }
   return {};
 }
@@ -240,8 +259,9 @@ Config parse_args(int argc, char** argv) {
   cfg.N.erase(std::unique(cfg.N.begin(), cfg.N.end()), cfg.N.end());
 
   if (methods_arg.empty())
-    methods_arg = cfg.quick ? "radau_iia:2,radau_iia:3,gauss_legendre:2,lobatto_iiic:3,explicit_rk:4"
-                            : "radau_iia,gauss_legendre,lobatto_iiic,explicit_rk";
+    methods_arg = cfg.quick
+                      ? "radau_iia:2,radau_iia:3,gauss_legendre:2,lobatto_iiic:3,explicit_rk:4"
+                      : "radau_iia,gauss_legendre,lobatto_iiic,explicit_rk";
   for (const std::string& item : split(methods_arg, ',')) {
     const auto colon = item.find(':');
     const std::string name = item.substr(0, colon);
@@ -279,8 +299,8 @@ Run run_one(const Method& m, bool use_fesd, int N_sim, const Config& cfg) {
   r.h = fesd_bench::kOscillatorT / N_sim;
   static const fesd::Pss model = fesd_bench::oscillator_model();
   try {
-    const fesd::IntegratorResult res = fesd::integrate(model, fesd_bench::oscillator_x0(),
-                                                       fesd_bench::kOscillatorT, N_sim, opt);
+    const fesd::IntegratorResult res =
+        fesd::integrate(model, fesd_bench::oscillator_x0(), fesd_bench::kOscillatorT, N_sim, opt);
     r.status = res.status;
     r.message = res.message;
     r.err = fesd_bench::oscillator_errors(res);
@@ -331,26 +351,32 @@ int main(int argc, char** argv) {
                      "iter %5d  %7.2f s  %s\n",
                      done, total, cfg.methods[mi].name.c_str(), f ? "FESD" : "std", N, r.err.x_T,
                      fmt_opt(r.err.t_s, "{:.2e}").c_str(), r.err.n_switches, r.nlps, r.iterations,
-                     r.wall_s, r.ok() ? "ok" : (std::string(to_string(r.status)) + ": " + r.message).c_str());
+                     r.wall_s,
+                     r.ok() ? "ok" : (std::string(to_string(r.status)) + ": " + r.message).c_str());
         runs[mi].back().push_back(r);
       }
     }
   }
 
   fmt::print("Fig. 8: nonsmooth oscillator (47), T = pi/2, N_FE = 2, h = T/N_sim\n");
-  fmt::print("IPOPT tol {:.0e}, complementarity_tol {:.0e}, sigma_N {:.0e}; fit window {:.0e} < E < {:.0e}\n",
-             cfg.ipopt_tol, cfg.comp_tol, cfg.sigma_N, kFitLow, kFitHigh);
-  fmt::print("FAIL = status not success; '-' = no switch detected; '*' = more than one switch detected\n");
+  fmt::print(
+      "IPOPT tol {:.0e}, complementarity_tol {:.0e}, sigma_N {:.0e}; fit window {:.0e} < E < "
+      "{:.0e}\n",
+      cfg.ipopt_tol, cfg.comp_tol, cfg.sigma_N, kFitLow, kFitHigh);
+  fmt::print(
+      "FAIL = status not success; '-' = no switch detected; '*' = more than one switch detected\n");
 
   // ---- error tables: rows N_sim, columns methods ----
   for (std::size_t k = 0; k < modes.size(); ++k) {
     for (bool t_s : {false, true}) {
-      fmt::print("\n{} {}\n", modes[k] ? "FESD" : "Standard", t_s ? "|t_s - 1|" : "E(T) = ||x(T) - x_exact||");
+      fmt::print("\n{} {}\n", modes[k] ? "FESD" : "Standard",
+                 t_s ? "|t_s - 1|" : "E(T) = ||x(T) - x_exact||");
       std::string head = fmt::format("{:>5} {:>8}", "N_sim", "h");
       for (const Method& m : cfg.methods) head += fmt::format(" {:>9}", m.label);
       fmt::print("{}\n", head);
       for (std::size_t j = 0; j < cfg.N.size(); ++j) {
-        std::string line = fmt::format("{:>5} {:>8.4f}", cfg.N[j], fesd_bench::kOscillatorT / cfg.N[j]);
+        std::string line =
+            fmt::format("{:>5} {:>8.4f}", cfg.N[j], fesd_bench::kOscillatorT / cfg.N[j]);
         for (std::size_t mi = 0; mi < cfg.methods.size(); ++mi)
           line += fmt::format(" {:>9}", cell(runs[mi][k][j], t_s));
         fmt::print("{}\n", line);
@@ -360,8 +386,9 @@ int main(int argc, char** argv) {
 
   // ---- summary: fitted slopes ----
   nlohmann::json jsum = nlohmann::json::array();
-  fmt::print("\nSlopes of log E against log h (least squares, {:.0e} < E < {:.0e}; (k) = points used)\n",
-             kFitLow, kFitHigh);
+  fmt::print(
+      "\nSlopes of log E against log h (least squares, {:.0e} < E < {:.0e}; (k) = points used)\n",
+      kFitLow, kFitHigh);
   fmt::print("{:<22} {:>5} {:>10} {:>10} {:>9} {:>10} {:>10}  {:<26} {:>8}\n", "method", "order",
              "std", "FESD", "FESD-ord", "t_s FESD", "t_s std", "FESD local slopes", "wall s");
   for (std::size_t mi = 0; mi < cfg.methods.size(); ++mi) {
@@ -392,10 +419,11 @@ int main(int argc, char** argv) {
     std::string local;
     if (fx[1])
       for (double s : fx[1]->local) local += fmt::format("{}{:.1f}", local.empty() ? "" : " ", s);
-    fmt::print("{:<22} {:>5} {:>10} {:>10} {:>9} {:>10} {:>10}  {:<26} {:>8.1f}{}\n", m.name, m.order,
-               slope(fx[0]), slope(fx[1]), fmt_opt(diff, "{:+.2f}"), slope(ft[1]), slope(ft[0]),
-               local.empty() ? "-" : local, wall,
-               failures ? fmt::format("  ({} failed run{})", failures, failures == 1 ? "" : "s") : "");
+    fmt::print(
+        "{:<22} {:>5} {:>10} {:>10} {:>9} {:>10} {:>10}  {:<26} {:>8.1f}{}\n", m.name, m.order,
+        slope(fx[0]), slope(fx[1]), fmt_opt(diff, "{:+.2f}"), slope(ft[1]), slope(ft[0]),
+        local.empty() ? "-" : local, wall,
+        failures ? fmt::format("  ({} failed run{})", failures, failures == 1 ? "" : "s") : "");
     auto jfit = [](const std::optional<Fit>& f) -> nlohmann::json {
       if (!f) return nullptr;
       nlohmann::json j;
@@ -446,19 +474,20 @@ int main(int argc, char** argv) {
     for (std::size_t mi = 0; mi < cfg.methods.size(); ++mi)
       for (const auto& mode_runs : runs[mi])
         for (const Run& r : mode_runs)
-          jr.push_back({{"method", r.method->name},
-                        {"use_fesd", r.fesd},
-                        {"N_sim", r.N_sim},
-                        {"h", r.h},
-                        {"error_x", r.ok() ? nlohmann::json(r.err.x_T) : nlohmann::json(nullptr)},
-                        {"error_t_s", r.err.t_s ? nlohmann::json(*r.err.t_s) : nlohmann::json(nullptr)},
-                        {"n_switches", r.err.n_switches},
-                        {"status", std::string(fesd::to_string(r.status))},
-                        {"message", r.message},
-                        {"wall_s", r.wall_s},
-                        {"nlps", r.nlps},
-                        {"ipopt_iterations", r.iterations},
-                        {"max_comp_residual", r.max_comp}});
+          jr.push_back(
+              {{"method", r.method->name},
+               {"use_fesd", r.fesd},
+               {"N_sim", r.N_sim},
+               {"h", r.h},
+               {"error_x", r.ok() ? nlohmann::json(r.err.x_T) : nlohmann::json(nullptr)},
+               {"error_t_s", r.err.t_s ? nlohmann::json(*r.err.t_s) : nlohmann::json(nullptr)},
+               {"n_switches", r.err.n_switches},
+               {"status", std::string(fesd::to_string(r.status))},
+               {"message", r.message},
+               {"wall_s", r.wall_s},
+               {"nlps", r.nlps},
+               {"ipopt_iterations", r.iterations},
+               {"max_comp_residual", r.max_comp}});
     j["runs"] = jr;
     j["summary"] = jsum;
     std::ofstream os(cfg.json);

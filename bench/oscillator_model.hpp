@@ -41,8 +41,8 @@ struct Oscillator {
 };
 
 inline fesd::Pss oscillator_model() {
-  fesd::Pss m = fesd::make_pss(
-      Oscillator{}, fesd::PssDims{.n_x = 2, .subsystems = {fesd::Subsystem::from_c(1)}});
+  fesd::Pss m = fesd::make_pss(Oscillator{},
+                               fesd::PssDims{.n_x = 2, .subsystems = {fesd::Subsystem::from_c(1)}});
   m.state_names = {"x1", "x2"};
   return m;
 }

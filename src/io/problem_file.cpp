@@ -68,29 +68,46 @@ struct OptionSpec {
   void (*set)(SimulationProblem&, const OptionValue&);
 };
 
-// clang-format off
+using Sp = SimulationProblem;
+using Ov = OptionValue;
+
+// Every scalar option: table, file key, kind, and where it goes.
 constexpr std::array<OptionSpec, 19> kOptions{{
-    {"simulation", "T_sim", Kind::Double, [](SimulationProblem& q, const OptionValue& v) { q.T_sim = v.d; }},
-    {"simulation", "N_sim", Kind::Int, [](SimulationProblem& q, const OptionValue& v) { q.N_sim = v.i; }},
-    {"discretization", "rk_scheme", Kind::Scheme, [](SimulationProblem& q, const OptionValue& v) { q.options.discretization.rk_scheme = v.scheme; }},
-    {"discretization", "n_s", Kind::Int, [](SimulationProblem& q, const OptionValue& v) { q.options.discretization.n_s = v.i; }},
-    {"discretization", "N_finite_elements", Kind::Int, [](SimulationProblem& q, const OptionValue& v) { q.options.discretization.N_FE = v.i; }},
-    {"discretization", "use_fesd", Kind::Bool, [](SimulationProblem& q, const OptionValue& v) { q.options.discretization.use_fesd = v.b; }},
-    {"discretization", "cross_comp_mode", Kind::CrossCompMode, [](SimulationProblem& q, const OptionValue& v) { q.options.discretization.cross_comp = v.cross; }},
-    {"discretization", "step_equilibration", Kind::StepEqMode, [](SimulationProblem& q, const OptionValue& v) { q.options.discretization.step_eq = v.step; }},
-    {"discretization", "gamma_h", Kind::Double, [](SimulationProblem& q, const OptionValue& v) { q.options.discretization.gamma_h = v.d; }},
-    {"discretization", "rho_h", Kind::Double, [](SimulationProblem& q, const OptionValue& v) { q.options.discretization.rho_h = v.d; }},
-    {"homotopy", "sigma_0", Kind::Double, [](SimulationProblem& q, const OptionValue& v) { q.options.homotopy.sigma_0 = v.d; }},
-    {"homotopy", "homotopy_update_slope", Kind::Double, [](SimulationProblem& q, const OptionValue& v) { q.options.homotopy.homotopy_update_slope = v.d; }},
-    {"homotopy", "sigma_N", Kind::Double, [](SimulationProblem& q, const OptionValue& v) { q.options.homotopy.sigma_N = v.d; }},
-    {"homotopy", "complementarity_tol", Kind::Double, [](SimulationProblem& q, const OptionValue& v) { q.options.homotopy.complementarity_tol = v.d; }},
-    {"homotopy", "N_homotopy", Kind::Int, [](SimulationProblem& q, const OptionValue& v) { q.options.homotopy.max_homotopy_steps = v.i; }},
-    {"ipopt", "tol", Kind::Double, [](SimulationProblem& q, const OptionValue& v) { q.options.nlp.tol = v.d; }},
-    {"ipopt", "acceptable_tol", Kind::Double, [](SimulationProblem& q, const OptionValue& v) { q.options.nlp.acceptable_tol = v.d; }},
-    {"ipopt", "max_iter", Kind::Int, [](SimulationProblem& q, const OptionValue& v) { q.options.nlp.max_iter = v.i; }},
-    {"ipopt", "print_level", Kind::Int, [](SimulationProblem& q, const OptionValue& v) { q.options.nlp.print_level = v.i; }},
+    {"simulation", "T_sim", Kind::Double, [](Sp& q, const Ov& v) { q.T_sim = v.d; }},
+    {"simulation", "N_sim", Kind::Int, [](Sp& q, const Ov& v) { q.N_sim = v.i; }},
+    {"discretization", "rk_scheme", Kind::Scheme,
+     [](Sp& q, const Ov& v) { q.options.discretization.rk_scheme = v.scheme; }},
+    {"discretization", "n_s", Kind::Int,
+     [](Sp& q, const Ov& v) { q.options.discretization.n_s = v.i; }},
+    {"discretization", "N_finite_elements", Kind::Int,
+     [](Sp& q, const Ov& v) { q.options.discretization.N_FE = v.i; }},
+    {"discretization", "use_fesd", Kind::Bool,
+     [](Sp& q, const Ov& v) { q.options.discretization.use_fesd = v.b; }},
+    {"discretization", "cross_comp_mode", Kind::CrossCompMode,
+     [](Sp& q, const Ov& v) { q.options.discretization.cross_comp = v.cross; }},
+    {"discretization", "step_equilibration", Kind::StepEqMode,
+     [](Sp& q, const Ov& v) { q.options.discretization.step_eq = v.step; }},
+    {"discretization", "gamma_h", Kind::Double,
+     [](Sp& q, const Ov& v) { q.options.discretization.gamma_h = v.d; }},
+    {"discretization", "rho_h", Kind::Double,
+     [](Sp& q, const Ov& v) { q.options.discretization.rho_h = v.d; }},
+    {"homotopy", "sigma_0", Kind::Double,
+     [](Sp& q, const Ov& v) { q.options.homotopy.sigma_0 = v.d; }},
+    {"homotopy", "homotopy_update_slope", Kind::Double,
+     [](Sp& q, const Ov& v) { q.options.homotopy.homotopy_update_slope = v.d; }},
+    {"homotopy", "sigma_N", Kind::Double,
+     [](Sp& q, const Ov& v) { q.options.homotopy.sigma_N = v.d; }},
+    {"homotopy", "complementarity_tol", Kind::Double,
+     [](Sp& q, const Ov& v) { q.options.homotopy.complementarity_tol = v.d; }},
+    {"homotopy", "N_homotopy", Kind::Int,
+     [](Sp& q, const Ov& v) { q.options.homotopy.max_homotopy_steps = v.i; }},
+    {"ipopt", "tol", Kind::Double, [](Sp& q, const Ov& v) { q.options.nlp.tol = v.d; }},
+    {"ipopt", "acceptable_tol", Kind::Double,
+     [](Sp& q, const Ov& v) { q.options.nlp.acceptable_tol = v.d; }},
+    {"ipopt", "max_iter", Kind::Int, [](Sp& q, const Ov& v) { q.options.nlp.max_iter = v.i; }},
+    {"ipopt", "print_level", Kind::Int,
+     [](Sp& q, const Ov& v) { q.options.nlp.print_level = v.i; }},
 }};
-// clang-format on
 
 std::vector<std::string_view> keys_of_table(std::string_view table) {
   std::vector<std::string_view> keys;
@@ -410,7 +427,7 @@ struct Symbols {
   int first_u() const { return static_cast<int>(x.size()) + (time_index >= 0 ? 1 : 0); }
 };
 
-/// One subsystem as read: expressions plus the sign matrix and where each part was written.
+/// One subsystem as read: its expressions, sign matrix (empty: all 2^n_c rows) and regions.
 struct RawSubsystem {
   ExpressionSubsystem expressions;
   Eigen::MatrixXd S;  // empty: all 2^n_c rows
@@ -643,10 +660,10 @@ void read_model(const Reader& r, const toml::table& root, SimulationProblem& pro
   }
 
   // The clock: appended if some expression reads t.
-  const bool has_clock = sym.time_index >= 0 && std::any_of(subsystems.begin(), subsystems.end(),
-                                                            [&](const RawSubsystem& s) {
-                                                              return uses_symbol(s, sym.time_index);
-                                                            });
+  bool has_clock = false;
+  if (sym.time_index >= 0)
+    for (const RawSubsystem& s : subsystems)
+      has_clock = has_clock || uses_symbol(s, sym.time_index);
   const int n_x_user = static_cast<int>(sym.x.size());
   const int n_x = n_x_user + (has_clock ? 1 : 0);
   if (has_clock) {

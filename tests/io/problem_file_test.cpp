@@ -6,6 +6,8 @@
 #include <cmath>
 #include <numbers>
 #include <string>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -50,6 +52,25 @@ Eigen::VectorXd eval_f(const Pss& m, int region, const Eigen::VectorXd& x, const
 Eigen::VectorXd g_of_c(const Pss& m, const std::vector<double>& c) {
   const Eigen::Map<const Eigen::VectorXd> cv(c.data(), static_cast<Eigen::Index>(c.size()));
   return -m.S(0) * cv;
+}
+
+std::string fmt_name(int i) {
+  return "\"q" + std::to_string(i) + "\"";
+}
+
+/// Input i of n for every scalar type: a variable with gradient e_i (and, for Hyper, the second
+/// direction e_1, i.e. q2).
+template <class T>
+T make_input(double v, int i, int n) {
+  if constexpr (std::is_same_v<T, double>) {
+    return v;
+  } else if constexpr (std::is_same_v<T, ad::Pattern>) {
+    return ad::Pattern::variable(v, i);
+  } else if constexpr (std::is_same_v<T, ad::Jet<128>>) {
+    return ad::Jet<128>::variable(v, i, n);
+  } else {
+    return T(ad::Jet<128>::variable(v, i, n), ad::Jet<128>(i == 1 ? 1.0 : 0.0));
+  }
 }
 
 void expect_vector_near(const Eigen::VectorXd& got, const std::vector<double>& want) {
@@ -441,6 +462,64 @@ T_sim = 1
   const std::vector<double> c = eval_c(q.model, x, p);
   // g = -S c with S rows (1,1), (1,-1), (-1,1), (-1,-1).
   expect_vector_near(g_of_c(q.model, c), {2.5, -3.5, 3.5, -2.5});
+}
+
+TEST(ProblemFile, ManyStatesEvaluateWithEveryScalarType) {
+  // 12 states, 1 control, 2 parameters: more symbols than fit the evaluation's stack buffer for
+  // the large AD types, so both buffer paths are used. f_0 = (q2, ..., q12, a*q1*q2 + u + b).
+  std::string x = "x = [", f0 = "[", f1 = "[";
+  for (int i = 1; i <= 12; ++i) {
+    x += fmt_name(i) + (i < 12 ? ", " : "]");
+    if (i < 12) {
+      f0 += "\"q" + std::to_string(i + 1) + "\", ";
+      f1 += "\"-q" + std::to_string(i + 1) + "\", ";
+    }
+  }
+  f0 += "\"a*q1*q2 + u + b\"]";
+  f1 += "\"0\"]";
+  const std::string text = "[model]\n" + x + "\nu = [\"u\"]\np = { a = 2.0, b = 0.5 }\n" +
+                           "c = [\"q1 - q12\"]\nF = [" + f0 + ", " + f1 + "]\n" +
+                           "x0 = [1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12]\n" +
+                           "[simulation]\nT_sim = 1\nu = [0.25]\n";
+  const SimulationProblem q = parse_simulation_problem(text, "many.toml");
+  const Pss& m = q.model;
+  ASSERT_EQ(m.n_x(), 12);
+
+  const auto check = [&](auto tag) {
+    using T = decltype(tag);
+    std::vector<T> xs, fs(12), cs(1);
+    for (int i = 0; i < 12; ++i) xs.push_back(make_input<T>(q.x0[i], i, 12));
+    const std::vector<T> us{T(0.25)}, ps{T(2.0), T(0.5)};
+    m.functions().f(0, xs.data(), us.data(), ps.data(), fs.data());
+    m.functions().c(xs.data(), ps.data(), cs.data());
+    for (int i = 0; i < 11; ++i) EXPECT_EQ(ad::value_of(fs[i]), q.x0[i + 1]) << i;
+    EXPECT_EQ(ad::value_of(fs[11]), 2.0 * 1.0 * 2.0 + 0.25 + 0.5);
+    EXPECT_EQ(ad::value_of(cs[0]), 1.0 - 12.0);
+    return std::make_pair(fs, cs);
+  };
+  check(0.0);
+  {
+    const auto [fs, cs] = check(ad::Jet<128>());
+    EXPECT_EQ(fs[11].d(0), 2.0 * 2.0);  // d(a q1 q2)/dq1 = a q2
+    EXPECT_EQ(fs[11].d(1), 2.0 * 1.0);
+    EXPECT_EQ(fs[11].d(2), 0.0);
+    EXPECT_EQ(cs[0].d(0), 1.0);
+    EXPECT_EQ(cs[0].d(11), -1.0);
+  }
+  {
+    // Hyper: gradient plus the Hessian column of the direction seeded in d (here q2).
+    const auto [fs, cs] = check(ad::Hyper<128>());
+    EXPECT_EQ(fs[11].v.d(0), 4.0);
+    EXPECT_EQ(fs[11].d.v, 2.0);     // directional derivative along q2: a q1
+    EXPECT_EQ(fs[11].d.d(0), 2.0);  // d^2 f / dq2 dq1 = a
+  }
+  {
+    const auto [fs, cs] = check(ad::Pattern());
+    EXPECT_EQ(fs[11].dep, (std::vector<int>{0, 1}));
+    EXPECT_EQ(fs[11].hess, (std::vector<std::pair<int, int>>{{1, 0}}));
+    EXPECT_EQ(fs[3].dep, std::vector<int>{4});
+    EXPECT_TRUE(fs[3].hess.empty());
+  }
 }
 
 // ---- overrides --------------------------------------------------------------------------------
