@@ -88,7 +88,7 @@ struct Config {
   std::string csv, json;
 };
 
-[[noreturn]] void usage(const std::string& why) {
+[[noreturn]] void usage(const std::string& why, int exit_code = 2) {
   std::fprintf(
       stderr,
       "oscillator_timing: %s\n"
@@ -96,7 +96,7 @@ struct Config {
       "                         [--N 10,20,40,80] [--comp-tol X] [--sigma-N X]\n"
       "                         [--csv FILE] [--json FILE]\n",
       why.c_str());
-  std::exit(2);
+  std::exit(exit_code);
 }
 
 int parse_int(const std::string& flag, const std::string& v) {
@@ -163,7 +163,7 @@ Config parse_args(int argc, char** argv) {
     } else if (a == "--json") {
       c.json = value();
     } else if (a == "-h" || a == "--help") {
-      usage("help");
+      usage("FESD timing on the oscillator (47) and the PEERS.md rows", 0);
     } else {
       usage("unknown argument " + a);
     }
@@ -287,8 +287,8 @@ int main(int argc, char** argv) {
     row("per integration step", wall, 1e3 / steps, "ms");
     row("  derivative evaluation", der, 1.0, "s");
     row("  IPOPT + MUMPS (w/o evaluations)", sol, 1.0, "s");
-    row("  setup (NLP build)", setup, 1.0, "s");
-    row("  other (LP, guesses, results)", other, 1.0, "s");
+    row("  setup (NLP build)", setup, 1e3, "ms");
+    row("  other (LP, guesses, results)", other, 1e3, "ms");
     const double busy = der.first + sol.first;
     fmt::print("{:<34} {:>9.1f} %  of derivative + IPOPT time\n", "derivative share",
                busy > 0 ? 100 * der.first / busy : 0.0);
@@ -320,20 +320,23 @@ int main(int argc, char** argv) {
     fmt::print(
         "\n(b) PEERS.md rows: fesd vs nosnoc_py (PEERS.md: nosnoc_py 0c3f3bb, CasADi 3.6.3,\n"
         "    IPOPT 3.11.9 + MUMPS, 2-core machine, timings +-30 %)\n");
-    fmt::print("{:>3} {:>5} | {:>9} {:>9} {:>7} {:>6} {:>6} {:<8} | {:>9} {:>9} {:>6}  {}\n", "n_s",
-               "N_sim", "err x(T)", "err t_s", "wall s", "ms/st", "NLP/st", "status", "err x(T)",
-               "err t_s", "wall s", "nosnoc_py note");
+    fmt::print("{:>3} {:>5} | {:>9} {:>9} {:>7} {:>6} {:>6} {:<10} | {:>9} {:>9} {:>6}  {}\n",
+               "n_s", "N_sim", "err x(T)", "err t_s", "wall s", "ms/st", "NLP/st", "status",
+               "err x(T)", "err t_s", "wall s", "nosnoc_py note");
     for (const Measurement& m : ms) {
       const PeerRow* p = peer(m.n_s, m.N_sim);
       const double steps = std::max(1, m.steps);
       fmt::print(
-          "{:>3} {:>5} | {:>9} {:>9} {:>7.2f} {:>6.1f} {:>6.1f} {:<8} | {:>9} {:>9} {:>6}  {}\n",
+          "{:>3} {:>5} | {:>9} {:>9} {:>7.2f} {:>6.1f} {:>6.1f} {:<10} | {:>9} {:>9} {:>6}  {}\n",
           m.n_s, m.N_sim, sci(m.err.x_T), m.err.t_s ? sci(*m.err.t_s) : "-", m.summary.wall_s,
           1e3 * m.summary.wall_s / steps, m.summary.homotopy_steps / steps,
           m.status == fesd::Status::Success ? "ok" : std::string(fesd::to_string(m.status)),
           p ? sci(p->error_x) : "-", p ? sci(p->error_t_s) : "-",
           p ? fmt::format("{:.1f}", p->wall_s) : "-", p ? p->note : "");
     }
+    for (const Measurement& m : ms)
+      if (m.status != fesd::Status::Success)
+        fmt::print("fesd n_s = {}, N_sim = {}: {}\n", m.n_s, m.N_sim, m.message);
   }
 
   if (!cfg.csv.empty()) {
