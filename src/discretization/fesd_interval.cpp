@@ -188,6 +188,7 @@ void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
   x_.assign(N_FE_ + 1, {});
   x_[0] = in.s0;
   lambda_end_.assign(N_FE_, {});
+  boundary_vars_.assign(N_FE_, false);
   mu_end_.assign(N_FE_, {});
   for (int n = 0; n < N_FE_; ++n) {
     const double h_lb = fesd ? (1.0 - opt_.gamma_h) * h0 : h0;
@@ -207,7 +208,8 @@ void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
     } else {
       x_[n + 1] = range(nlp.add_variables(n_x, -kInf, kInf, 0.0), n_x);
       const bool boundary = fesd && (n < N_FE_ - 1 || in.boundary_at_end);
-      if (boundary) {  // (33): lambda, mu at t_{n+1} from LP(x_{n+1}); theta discarded (39)
+      if (boundary) {
+        boundary_vars_[n] = true;  // (33): lambda, mu at t_{n+1} from LP(x_{n+1}); theta discarded (39)
         lambda_end_[n] = range(nlp.add_variables(n_th, 0.0, kInf, 0.0), n_th);
         mu_end_[n] = range(nlp.add_variables(n_sys, -kInf, kInf, 0.0), n_sys);
       }
@@ -267,7 +269,7 @@ void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
         for (int j : b_cols) vars.push_back(V(n, j, i));
         nlp.add_constraint(continuity, vars, 0.0, 0.0);
       }
-      if (!lambda_end_[n].empty()) {  // (33) at x_{n+1}
+      if (boundary_vars_[n]) {  // (33) at x_{n+1}
         std::vector<int> lv = x_[n + 1];
         lv.insert(lv.end(), lambda_end_[n].begin(), lambda_end_[n].end());
         lv.insert(lv.end(), mu_end_[n].begin(), mu_end_[n].end());
@@ -283,7 +285,7 @@ void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
     std::vector<int> start = n == 0 ? in.lambda_start : lambda_end_[n - 1];
     if (!start.empty()) points_[n].push_back(start);
     for (int s = 0; s < n_s_; ++s) points_[n].push_back(range(lambda(n, s, 0), n_th));
-    if (!stiffly_accurate_ && !lambda_end_[n].empty()) points_[n].push_back(lambda_end_[n]);
+    if (boundary_vars_[n]) points_[n].push_back(lambda_end_[n]);
   }
 
   step_eq_rows_.clear();
@@ -384,7 +386,7 @@ void FesdInterval::set_guess(nlp::BlockNlp& nlp, const Eigen::VectorXd& x0,
       }
       for (int k = 0; k < n_sys; ++k) w[mu(n, s, k)] = lp.mu[k];
     }
-    if (!stiffly_accurate_ && !lambda_end_[n].empty()) {
+    if (boundary_vars_[n]) {
       for (int r = 0; r < n_th; ++r) w[lambda_end_[n][r]] = lp.lambda[r];
       for (int k = 0; k < n_sys; ++k) w[mu_end_[n][k]] = lp.mu[k];
     }

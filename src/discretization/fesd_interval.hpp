@@ -98,6 +98,7 @@ class FesdInterval {
   std::vector<std::vector<int>> x_;
   std::vector<int> h_, V_, X_, theta_, lambda_, mu_;
   std::vector<std::vector<int>> lambda_end_, mu_end_;
+  std::vector<bool> boundary_vars_;  // element n has boundary LP variables (33) at t_{n+1}
   std::vector<std::vector<std::vector<int>>> points_;
   std::vector<CompPair> residual_pairs_;
   std::vector<CompGroup> groups_;

@@ -96,6 +96,9 @@ IntegratorResult integrate(const Pss& model, const Eigen::VectorXd& x0_in, doubl
   in.lambda_start = fixed_vars(nlp, n_th);
   in.mu_start = fixed_vars(nlp, n_sys);
   in.T = T_step;
+  // Non-stiffly-accurate schemes: boundary values (33) at the step end too, so that a switch cannot
+  // hide between the last stage and the end of the step.
+  in.boundary_at_end = true;
   discretization::FesdInterval iv(model, tab, d);
   iv.build(nlp, in);
   const std::vector<int> comp_rows = mpcc::add_scholtes_rows(nlp, iv.groups());

@@ -72,6 +72,21 @@ INSTANTIATE_TEST_SUITE_P(Schemes, CrossingTest,
                                            std::pair{RkScheme::LobattoIIIC, 2},
                                            std::pair{RkScheme::ExplicitRK, 4}));
 
+// Schemes that are not stiffly accurate need the boundary values (33) at the end of each step too:
+// with N_sim = 10, T = 1.9 the switch t_s = 1/3 falls into the last element of step 2.
+TEST(Crossing, SwitchInTheLastElementOfAStepGaussLegendre) {
+  Eigen::VectorXd x0(1);
+  x0 << -1.0;
+  for (int n_s : {1, 2}) {
+    const auto r =
+        fesd::integrate(sign_model(2, 1), x0, 1.9, 10, options(RkScheme::GaussLegendre, n_s));
+    ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+    ASSERT_EQ(r.switches.size(), 1u) << "n_s = " << n_s;
+    EXPECT_NEAR(r.switches[0].t, 1.0 / 3.0, 1e-7) << "n_s = " << n_s;
+    EXPECT_NEAR(r.x_final()[0], 1.9 - 1.0 / 3.0, 1e-7) << "n_s = " << n_s;
+  }
+}
+
 // Standard time-stepping on the same problem cannot place the switch: first-order error.
 TEST(Crossing, StandardMethodMissesTheSwitch) {
   Eigen::VectorXd x0(1);
