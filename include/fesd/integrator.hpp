@@ -26,6 +26,7 @@ struct HomotopyRow {
   int nlp_iterations = 0;
   std::string nlp_status;      ///< IPOPT's return status, e.g. "Solve_Succeeded"
   double cpu_s = 0;
+  std::string linear_solver;   ///< KKT solver IPOPT used: "dense" (LAPACK LDL', small NLPs) or "mumps"
 };
 
 /// A detected switch: the active set changes at an element boundary.

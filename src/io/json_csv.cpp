@@ -74,7 +74,8 @@ json homotopy(const std::vector<std::vector<HomotopyRow>>& steps) {
                                   {"inf_pr", number(r.inf_pr)},
                                   {"nlp_iterations", r.nlp_iterations},
                                   {"nlp_status", r.nlp_status},
-                                  {"cpu_s", number(r.cpu_s)}});
+                                  {"cpu_s", number(r.cpu_s)},
+                                  {"linear_solver", r.linear_solver}});
     }
     a.push_back(std::move(rows_of_step));
   }

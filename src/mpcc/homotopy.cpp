@@ -66,7 +66,7 @@ HomotopyResult solve_homotopy(nlp::BlockNlp& nlp, const std::vector<int>& comp_r
     const nlp::NlpResult r = solver.solve(nlp, it, /*warm_start=*/k > 0);
     res.comp_residual = comp_residual(it.x.data(), residual_pairs);
     res.rows.push_back({k, sigma, res.comp_residual, r.objective, r.inf_pr, r.iterations,
-                        r.status, r.total_s});
+                        r.status, r.total_s, r.linear_solver});
     res.eval_s += r.eval_s;
     res.solver_s += r.total_s - r.eval_s;
     res.nlp_iterations += r.iterations;

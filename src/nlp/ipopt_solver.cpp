@@ -3,8 +3,11 @@
 // step; the status comes back in NlpResult.
 #include "nlp/ipopt_solver.hpp"
 
+#include <dlfcn.h>
+
 #include <chrono>
 #include <cstdlib>
+#include <filesystem>
 #include <string>
 
 #include <IpIpoptApplication.hpp>
@@ -155,6 +158,24 @@ class BlockTnlp final : public Ipopt::TNLP {
   int eval_failures_ = 0, iterations_ = 0;
 };
 
+/// Largest KKT dimension (n + m) solved with the dense LDL' solver; above it MUMPS. Dense costs
+/// (n + m)^3 / 3 flops per factorization, MUMPS a fixed ~0.5 ms per call (docs/benchmarks.md).
+constexpr int kDenseKktMax = 300;
+
+/// Loads libfesd_dense_kkt.so (next to libfesd.so) globally, so that IPOPT's loader, which opens
+/// "libhsl.so" for linear_solver = ma27, finds it by its SONAME. Once per process.
+bool load_dense_kkt() {
+  static const bool ok = [] {
+    Dl_info info;
+    if (dladdr(reinterpret_cast<void*>(&load_dense_kkt), &info) == 0 || info.dli_fname == nullptr)
+      return false;
+    const auto path =
+        std::filesystem::path(info.dli_fname).parent_path() / "libfesd_dense_kkt.so";
+    return dlopen(path.c_str(), RTLD_NOW | RTLD_GLOBAL) != nullptr;
+  }();
+  return ok;
+}
+
 void set_option(Ipopt::IpoptApplication& app, const std::string& name, const std::string& value) {
   Ipopt::SmartPtr<const Ipopt::RegisteredOption> opt = app.RegOptions()->GetOption(name);
   if (!Ipopt::IsValid(opt))
@@ -183,6 +204,7 @@ void set_option(Ipopt::IpoptApplication& app, const std::string& name, const std
 
 struct IpoptSolver::Impl {
   Ipopt::SmartPtr<Ipopt::IpoptApplication> app;
+  bool user_linear_solver = false;  // the caller chose IPOPT's linear_solver: never override it
 };
 
 IpoptSolver::IpoptSolver(const NlpOptions& o) : impl_(std::make_unique<Impl>()) {
@@ -198,7 +220,10 @@ IpoptSolver::IpoptSolver(const NlpOptions& o) : impl_(std::make_unique<Impl>()) 
   // IPOPT relaxes every bound by 1e-8 by default, so "product <= sigma" would only hold up to
   // 1e-8: complementarity could never get below that. Bounds are kept exact.
   app.Options()->SetNumericValue("bound_relax_factor", 0.0);
-  for (const auto& [name, value] : o.extra) set_option(app, name, value);
+  for (const auto& [name, value] : o.extra) {
+    set_option(app, name, value);
+    if (name == "linear_solver") impl_->user_linear_solver = true;
+  }
   if (app.Initialize() != Ipopt::Solve_Succeeded)
     throw InvalidOption("ipopt: initialization failed (check the [ipopt] options)");
 }
@@ -210,11 +235,20 @@ NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_star
   Ipopt::IpoptApplication& app = *impl_->app;
   const bool warm = warm_start && start.has_duals();
   app.Options()->SetStringValue("warm_start_init_point", warm ? "yes" : "no");
+  std::string linear_solver;
+  if (impl_->user_linear_solver) {
+    app.Options()->GetStringValue("linear_solver", linear_solver, "");
+  } else {
+    const bool dense = nlp.num_variables() + nlp.num_constraints() <= kDenseKktMax && load_dense_kkt();
+    linear_solver = dense ? "ma27" : "mumps";
+    app.Options()->SetStringValue("linear_solver", linear_solver);
+  }
   Ipopt::SmartPtr<BlockTnlp> tnlp = new BlockTnlp(nlp, start, warm);
   const Ipopt::ApplicationReturnStatus s = app.OptimizeTNLP(Ipopt::SmartPtr<Ipopt::TNLP>(
       Ipopt::GetRawPtr(tnlp)));
   NlpResult r;
   r.status = status_name(s);
+  r.linear_solver = linear_solver == "ma27" && !impl_->user_linear_solver ? "dense" : linear_solver;
   r.success = s == Ipopt::Solve_Succeeded || s == Ipopt::Solved_To_Acceptable_Level;
   r.eval_error = tnlp->eval_failures() > 0 && !r.success;
   r.iterations = tnlp->iterations();

@@ -19,6 +19,7 @@ struct NlpResult {
   bool success = false;       ///< converged (to tol or acceptable_tol)
   bool eval_error = false;    ///< stopped because evaluations kept failing (NaN/inf)
   std::string status;         ///< backend status name, e.g. "Solve_Succeeded"
+  std::string linear_solver;  ///< KKT solver used: "dense" (LAPACK LDL') or "mumps"
   int iterations = 0;
   double objective = 0, inf_pr = 0, inf_du = 0;
   double eval_s = 0;          ///< time spent in function and derivative evaluations
