@@ -129,7 +129,8 @@ struct SquaredDeviation {
 };
 
 /// Step equilibration (31): (h_n - h_{n-1}) * eta_n (or tanh(eta_n)), with
-///   eta_n = prod_r ( sigma^{lambda,B}_r sigma^{lambda,F}_r + sigma^{theta,B}_r sigma^{theta,F}_r ).
+///   eta_n = prod_r ( sigma^{lambda,B}_r sigma^{lambda,F}_r + sigma^{theta,B}_r sigma^{theta,F}_r
+///   ).
 /// Index lists are local positions of the summed lambdas/thetas per region r.
 struct StepEquilibrationEq {
   int k = 0;
@@ -172,7 +173,8 @@ void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
   const Pss& m = model_;
   const int n_x = m.n_x(), n_th = m.n_theta(), n_sys = m.n_sys();
   if (static_cast<int>(in.s0.size()) != n_x || static_cast<int>(in.q.size()) != m.n_u() ||
-      static_cast<int>(in.p.size()) != m.n_p() || static_cast<int>(in.lambda_start.size()) != n_th ||
+      static_cast<int>(in.p.size()) != m.n_p() ||
+      static_cast<int>(in.lambda_start.size()) != n_th ||
       static_cast<int>(in.mu_start.size()) != n_sys)
     throw Error("internal: FesdInterval inputs do not match the model dimensions");
   const bool fesd = opt_.use_fesd;
@@ -209,7 +211,8 @@ void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
       x_[n + 1] = range(nlp.add_variables(n_x, -kInf, kInf, 0.0), n_x);
       const bool boundary = fesd && (n < N_FE_ - 1 || in.boundary_at_end);
       if (boundary) {
-        boundary_vars_[n] = true;  // (33): lambda, mu at t_{n+1} from LP(x_{n+1}); theta discarded (39)
+        boundary_vars_[n] =
+            true;  // (33): lambda, mu at t_{n+1} from LP(x_{n+1}); theta discarded (39)
         lambda_end_[n] = range(nlp.add_variables(n_th, 0.0, kInf, 0.0), n_th);
         mu_end_[n] = range(nlp.add_variables(n_sys, -kInf, kInf, 0.0), n_sys);
       }
@@ -360,7 +363,8 @@ void FesdInterval::build_complementarity() {
     for (int n = 0; n + 1 < N_FE_ || n == 0; ++n) {
       CompGroup g{cross_by_element[n]};
       if (n + 1 < N_FE_)
-        g.pairs.insert(g.pairs.end(), cross_by_element[n + 1].begin(), cross_by_element[n + 1].end());
+        g.pairs.insert(g.pairs.end(), cross_by_element[n + 1].begin(),
+                       cross_by_element[n + 1].end());
       groups_.push_back(std::move(g));
     }
   }

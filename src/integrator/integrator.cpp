@@ -67,7 +67,8 @@ IntegratorResult integrate(const Pss& model, const Eigen::VectorXd& x0_in, doubl
   check(options);
   if (model.n_x() < 1) throw InvalidModel("model: empty (n_x = 0)");
   if (x0_in.size() != model.n_x())
-    throw InvalidModel(fmt::format("x0 has {} entries, expected n_x = {}", x0_in.size(), model.n_x()));
+    throw InvalidModel(
+        fmt::format("x0 has {} entries, expected n_x = {}", x0_in.size(), model.n_x()));
   check_finite(x0_in, "x0");
   if (!std::isfinite(T_sim) || T_sim <= 0)
     throw InvalidOption(fmt::format("T_sim = {}: must be finite and > 0", T_sim));
@@ -173,7 +174,8 @@ IntegratorResult integrate(const Pss& model, const Eigen::VectorXd& x0_in, doubl
         res.mu.push_back(gather(w, iv.mu(n, s, 0), n_sys));
       }
       if (!res.active_set.empty() && res.active_set.back() != active)
-        res.switches.push_back({t, static_cast<int>(res.h.size()) - 1, res.active_set.back(), active});
+        res.switches.push_back(
+            {t, static_cast<int>(res.h.size()) - 1, res.active_set.back(), active});
       res.active_set.push_back(active);
       res.h.push_back(hn);
       t += hn;
@@ -189,10 +191,10 @@ IntegratorResult integrate(const Pss& model, const Eigen::VectorXd& x0_in, doubl
                    std::string(to_string(hr.status)).c_str());
     if (hr.status != Status::Success) {
       res.status = hr.status;
-      res.message = fmt::format("step {} of {} (t = {:.6g}): {} (last IPOPT status {}, "
-                                "complementarity residual {:.2e})",
-                                step + 1, N_sim, t, describe(hr.status), hr.last_nlp_status,
-                                hr.comp_residual);
+      res.message = fmt::format(
+          "step {} of {} (t = {:.6g}): {} (last IPOPT status {}, "
+          "complementarity residual {:.2e})",
+          step + 1, N_sim, t, describe(hr.status), hr.last_nlp_status, hr.comp_residual);
       break;
     }
   }

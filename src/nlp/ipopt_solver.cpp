@@ -10,11 +10,11 @@
 #include <filesystem>
 #include <string>
 
+#include <fmt/format.h>
 #include <IpIpoptApplication.hpp>
 #include <IpRegOptions.hpp>
 #include <IpSolveStatistics.hpp>
 #include <IpTNLP.hpp>
-#include <fmt/format.h>
 
 #include "fesd/error.hpp"
 
@@ -28,25 +28,44 @@ double seconds_since(Clock::time_point t0) {
 
 std::string status_name(Ipopt::ApplicationReturnStatus s) {
   switch (s) {
-    case Ipopt::Solve_Succeeded: return "Solve_Succeeded";
-    case Ipopt::Solved_To_Acceptable_Level: return "Solved_To_Acceptable_Level";
-    case Ipopt::Infeasible_Problem_Detected: return "Infeasible_Problem_Detected";
-    case Ipopt::Search_Direction_Becomes_Too_Small: return "Search_Direction_Becomes_Too_Small";
-    case Ipopt::Diverging_Iterates: return "Diverging_Iterates";
-    case Ipopt::User_Requested_Stop: return "User_Requested_Stop";
-    case Ipopt::Feasible_Point_Found: return "Feasible_Point_Found";
-    case Ipopt::Maximum_Iterations_Exceeded: return "Maximum_Iterations_Exceeded";
-    case Ipopt::Restoration_Failed: return "Restoration_Failed";
-    case Ipopt::Error_In_Step_Computation: return "Error_In_Step_Computation";
-    case Ipopt::Maximum_CpuTime_Exceeded: return "Maximum_CpuTime_Exceeded";
-    case Ipopt::Not_Enough_Degrees_Of_Freedom: return "Not_Enough_Degrees_Of_Freedom";
-    case Ipopt::Invalid_Problem_Definition: return "Invalid_Problem_Definition";
-    case Ipopt::Invalid_Option: return "Invalid_Option";
-    case Ipopt::Invalid_Number_Detected: return "Invalid_Number_Detected";
-    case Ipopt::Unrecoverable_Exception: return "Unrecoverable_Exception";
-    case Ipopt::NonIpopt_Exception_Thrown: return "NonIpopt_Exception_Thrown";
-    case Ipopt::Insufficient_Memory: return "Insufficient_Memory";
-    case Ipopt::Internal_Error: return "Internal_Error";
+    case Ipopt::Solve_Succeeded:
+      return "Solve_Succeeded";
+    case Ipopt::Solved_To_Acceptable_Level:
+      return "Solved_To_Acceptable_Level";
+    case Ipopt::Infeasible_Problem_Detected:
+      return "Infeasible_Problem_Detected";
+    case Ipopt::Search_Direction_Becomes_Too_Small:
+      return "Search_Direction_Becomes_Too_Small";
+    case Ipopt::Diverging_Iterates:
+      return "Diverging_Iterates";
+    case Ipopt::User_Requested_Stop:
+      return "User_Requested_Stop";
+    case Ipopt::Feasible_Point_Found:
+      return "Feasible_Point_Found";
+    case Ipopt::Maximum_Iterations_Exceeded:
+      return "Maximum_Iterations_Exceeded";
+    case Ipopt::Restoration_Failed:
+      return "Restoration_Failed";
+    case Ipopt::Error_In_Step_Computation:
+      return "Error_In_Step_Computation";
+    case Ipopt::Maximum_CpuTime_Exceeded:
+      return "Maximum_CpuTime_Exceeded";
+    case Ipopt::Not_Enough_Degrees_Of_Freedom:
+      return "Not_Enough_Degrees_Of_Freedom";
+    case Ipopt::Invalid_Problem_Definition:
+      return "Invalid_Problem_Definition";
+    case Ipopt::Invalid_Option:
+      return "Invalid_Option";
+    case Ipopt::Invalid_Number_Detected:
+      return "Invalid_Number_Detected";
+    case Ipopt::Unrecoverable_Exception:
+      return "Unrecoverable_Exception";
+    case Ipopt::NonIpopt_Exception_Thrown:
+      return "NonIpopt_Exception_Thrown";
+    case Ipopt::Insufficient_Memory:
+      return "Insufficient_Memory";
+    case Ipopt::Internal_Error:
+      return "Internal_Error";
   }
   return "Unknown_Status";
 }
@@ -55,8 +74,8 @@ class BlockTnlp final : public Ipopt::TNLP {
  public:
   BlockTnlp(const BlockNlp& nlp, Iterate& it, bool warm) : nlp_(nlp), it_(it), warm_(warm) {}
 
-  bool get_nlp_info(Ipopt::Index& n, Ipopt::Index& m, Ipopt::Index& nnz_jac,
-                    Ipopt::Index& nnz_h, IndexStyleEnum& style) override {
+  bool get_nlp_info(Ipopt::Index& n, Ipopt::Index& m, Ipopt::Index& nnz_jac, Ipopt::Index& nnz_h,
+                    IndexStyleEnum& style) override {
     n = nlp_.num_variables();
     m = nlp_.num_constraints();
     nnz_jac = nlp_.jac_nnz();
@@ -73,8 +92,8 @@ class BlockTnlp final : public Ipopt::TNLP {
     return true;
   }
   bool get_starting_point(Ipopt::Index n, bool init_x, Ipopt::Number* x, bool init_z,
-                          Ipopt::Number* z_L, Ipopt::Number* z_U, Ipopt::Index m,
-                          bool init_lambda, Ipopt::Number* lambda) override {
+                          Ipopt::Number* z_L, Ipopt::Number* z_U, Ipopt::Index m, bool init_lambda,
+                          Ipopt::Number* lambda) override {
     if (init_x) std::copy_n(it_.x.data(), n, x);
     if (init_z || init_lambda) {
       if (!warm_ || !it_.has_duals()) return false;
@@ -169,8 +188,7 @@ bool load_dense_kkt() {
     Dl_info info;
     if (dladdr(reinterpret_cast<void*>(&load_dense_kkt), &info) == 0 || info.dli_fname == nullptr)
       return false;
-    const auto path =
-        std::filesystem::path(info.dli_fname).parent_path() / "libfesd_dense_kkt.so";
+    const auto path = std::filesystem::path(info.dli_fname).parent_path() / "libfesd_dense_kkt.so";
     return dlopen(path.c_str(), RTLD_NOW | RTLD_GLOBAL) != nullptr;
   }();
   return ok;
@@ -178,8 +196,7 @@ bool load_dense_kkt() {
 
 void set_option(Ipopt::IpoptApplication& app, const std::string& name, const std::string& value) {
   Ipopt::SmartPtr<const Ipopt::RegisteredOption> opt = app.RegOptions()->GetOption(name);
-  if (!Ipopt::IsValid(opt))
-    throw InvalidOption(fmt::format("ipopt.{}: not an IPOPT option", name));
+  if (!Ipopt::IsValid(opt)) throw InvalidOption(fmt::format("ipopt.{}: not an IPOPT option", name));
   bool ok = false;
   switch (opt->Type()) {
     case Ipopt::OT_Number: {
@@ -195,9 +212,12 @@ void set_option(Ipopt::IpoptApplication& app, const std::string& name, const std
            app.Options()->SetIntegerValue(name, static_cast<Ipopt::Index>(v));
       break;
     }
-    default: ok = app.Options()->SetStringValue(name, value); break;
+    default:
+      ok = app.Options()->SetStringValue(name, value);
+      break;
   }
-  if (!ok) throw InvalidOption(fmt::format("ipopt.{} = '{}': IPOPT rejects this value", name, value));
+  if (!ok)
+    throw InvalidOption(fmt::format("ipopt.{} = '{}': IPOPT rejects this value", name, value));
 }
 
 }  // namespace
@@ -239,13 +259,14 @@ NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_star
   if (impl_->user_linear_solver) {
     app.Options()->GetStringValue("linear_solver", linear_solver, "");
   } else {
-    const bool dense = nlp.num_variables() + nlp.num_constraints() <= kDenseKktMax && load_dense_kkt();
+    const bool dense =
+        nlp.num_variables() + nlp.num_constraints() <= kDenseKktMax && load_dense_kkt();
     linear_solver = dense ? "ma27" : "mumps";
     app.Options()->SetStringValue("linear_solver", linear_solver);
   }
   Ipopt::SmartPtr<BlockTnlp> tnlp = new BlockTnlp(nlp, start, warm);
-  const Ipopt::ApplicationReturnStatus s = app.OptimizeTNLP(Ipopt::SmartPtr<Ipopt::TNLP>(
-      Ipopt::GetRawPtr(tnlp)));
+  const Ipopt::ApplicationReturnStatus s =
+      app.OptimizeTNLP(Ipopt::SmartPtr<Ipopt::TNLP>(Ipopt::GetRawPtr(tnlp)));
   NlpResult r;
   r.status = status_name(s);
   r.linear_solver = linear_solver == "ma27" && !impl_->user_linear_solver ? "dense" : linear_solver;

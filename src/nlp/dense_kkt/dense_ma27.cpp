@@ -50,7 +50,7 @@ void ma27ad_(const int* n, const int* nz, const int*, const int*, int*, const in
   *iflag = 0;
   *ops = static_cast<double>(*n) * (*n) * (*n) / 3.0;
   info[4] = *nz + (*n) * (*n) + *n;  // NRLNEC: required LA (values, factor, scaling)
-  info[5] = 2 * (*n) + 1;       // NIRNEC: required LIW
+  info[5] = 2 * (*n) + 1;            // NIRNEC: required LIW
 }
 
 void ma27bd_(const int* n_in, const int* nz_in, const int* irn, const int* icn, double* a,
@@ -97,7 +97,8 @@ void ma27bd_(const int* n_in, const int* nz_in, const int* irn, const int* icn, 
     for (int i = 0; i < n; ++i) scale[i] *= rmax[i];
   }
   for (int j = 0; j < n; ++j)
-    for (int i = j; i < n; ++i) amax = std::max(amax, std::abs(F[static_cast<std::size_t>(j) * n + i]));
+    for (int i = j; i < n; ++i)
+      amax = std::max(amax, std::abs(F[static_cast<std::size_t>(j) * n + i]));
   int lwork = -1, lapack_info = 0;
   double wsize = 0;
   dsytrf_("L", &n, F, &n, iw, &wsize, &lwork, &lapack_info);
@@ -116,18 +117,24 @@ void ma27bd_(const int* n_in, const int* nz_in, const int* irn, const int* icn, 
   for (int k = 0; k < n;) {
     const double d11 = F[static_cast<std::size_t>(k) * n + k];
     if (iw[k] > 0) {
-      if (std::abs(d11) <= tiny) singular = true;
-      else ++rank;
+      if (std::abs(d11) <= tiny)
+        singular = true;
+      else
+        ++rank;
       if (d11 < 0) ++neg;
       k += 1;
     } else {
       const double d21 = F[static_cast<std::size_t>(k) * n + k + 1];
       const double d22 = F[static_cast<std::size_t>(k + 1) * n + k + 1];
       const double det = d11 * d22 - d21 * d21;
-      if (std::abs(det) <= tiny * tiny) singular = true;
-      else rank += 2;
-      if (det < 0) neg += 1;
-      else if (d11 + d22 < 0) neg += 2;
+      if (std::abs(det) <= tiny * tiny)
+        singular = true;
+      else
+        rank += 2;
+      if (det < 0)
+        neg += 1;
+      else if (d11 + d22 < 0)
+        neg += 2;
       k += 2;
     }
   }
