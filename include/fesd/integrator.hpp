@@ -18,34 +18,38 @@ namespace fesd {
 
 /// One NLP of a homotopy (one row of the progress table).
 struct HomotopyRow {
-  int k = 0;                   ///< homotopy iteration
-  double sigma = 0;            ///< relaxation parameter
-  double comp_residual = 0;    ///< largest complementarity product after the solve
+  int k = 0;                 ///< homotopy iteration
+  double sigma = 0;          ///< relaxation parameter
+  double comp_residual = 0;  ///< largest complementarity product after the solve
   double objective = 0;
-  double inf_pr = 0;           ///< IPOPT's final primal infeasibility
+  double inf_pr = 0;  ///< IPOPT's final primal infeasibility
   int nlp_iterations = 0;
-  std::string nlp_status;      ///< IPOPT's return status, e.g. "Solve_Succeeded"
+  std::string nlp_status;  ///< IPOPT's return status, e.g. "Solve_Succeeded"
   double cpu_s = 0;
-  std::string linear_solver;   ///< KKT solver IPOPT used: "dense" (LAPACK LDL', small NLPs) or "mumps"
+  std::string
+      linear_solver;  ///< KKT solver IPOPT used: "dense" (LAPACK LDL', small NLPs) or "mumps"
 };
 
 /// A detected switch: the active set changes at an element boundary.
 struct SwitchEvent {
-  double t = 0;               ///< switching time t_s = boundary between the two elements
-  int element = 0;            ///< global index of the element that ends at t
-  std::vector<int> before;    ///< active regions (global region indices) before t
-  std::vector<int> after;     ///< active regions after t
+  double t = 0;             ///< switching time t_s = boundary between the two elements
+  int element = 0;          ///< global index of the element that ends at t
+  std::vector<int> before;  ///< active regions (global region indices) before t
+  std::vector<int> after;   ///< active regions after t
 };
 
 /// Work and time of a whole run.
 struct Summary {
-  int homotopy_steps = 0;      ///< NLPs solved
-  int nlp_iterations = 0;      ///< IPOPT iterations, all NLPs
-  double wall_s = 0;           ///< total wall time
-  double derivative_s = 0;     ///< time in fesd's function and derivative evaluations
-  double solver_s = 0;         ///< time inside IPOPT (incl. MUMPS), excluding the evaluations
-  double setup_s = 0;          ///< building the NLP (patterns, index maps)
+  int homotopy_steps = 0;        ///< NLPs solved
+  int nlp_iterations = 0;        ///< IPOPT iterations, all NLPs
+  double wall_s = 0;             ///< total wall time
+  double derivative_s = 0;       ///< time in fesd's function and derivative evaluations
+  double solver_s = 0;           ///< time inside IPOPT (incl. MUMPS), excluding the evaluations
+  double setup_s = 0;            ///< building the NLP (patterns, index maps)
   double max_comp_residual = 0;  ///< largest final complementarity residual over the steps
+  /// Steps whose homotopy failed with the chosen cross_comp_mode and were solved again with the
+  /// sparse form (28) from the same start (their rows follow in `homotopy`).
+  int fallback_steps = 0;
 };
 
 /// The result of integrate(). Time grid = all finite-element boundaries t_0 < ... < t_{N_sim N_FE}.
@@ -53,9 +57,9 @@ struct IntegratorResult {
   Status status = Status::NotRun;
   std::string message = "integrate() was not called";
 
-  std::vector<double> t;                 ///< element boundaries, size N_sim * N_FE + 1
-  std::vector<Eigen::VectorXd> x;        ///< x_n at t_n
-  std::vector<double> h;                 ///< h_n, size N_sim * N_FE
+  std::vector<double> t;           ///< element boundaries, size N_sim * N_FE + 1
+  std::vector<Eigen::VectorXd> x;  ///< x_n at t_n
+  std::vector<double> h;           ///< h_n, size N_sim * N_FE
 
   /// Stage points t_n + c_m h_n and the stage values there (size N_sim * N_FE * n_s each).
   std::vector<double> t_stage;
@@ -81,7 +85,7 @@ struct IntegratorResult {
 /// model's defaults); u: constant controls (empty: zero). Bad input (sizes, NaN, options) throws
 /// fesd::Error before any computation; numerical failure is reported in the result's status.
 IntegratorResult integrate(const Pss& model, const Eigen::VectorXd& x0, double T_sim, int N_sim,
-                           const IntegratorOptions& options = {},
-                           const Eigen::VectorXd& u = {}, const Eigen::VectorXd& p = {});
+                           const IntegratorOptions& options = {}, const Eigen::VectorXd& u = {},
+                           const Eigen::VectorXd& p = {});
 
 }  // namespace fesd

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -51,6 +52,32 @@ Eigen::VectorXd gather(const std::vector<double>& w, int first, int n) {
   return v;
 }
 
+/// The NLP of one integration step: built once, re-solved for every step with new fixed inputs.
+struct StepNlp {
+  nlp::BlockNlp nlp;
+  discretization::IntervalInputs in;
+  std::unique_ptr<discretization::FesdInterval> iv;
+  std::vector<int> comp_rows;
+};
+
+std::unique_ptr<StepNlp> build_step_nlp(const Pss& model, const Tableau& tab,
+                                        const DiscretizationOptions& d, double T_step) {
+  auto s = std::make_unique<StepNlp>();
+  s->in.s0 = fixed_vars(s->nlp, model.n_x());
+  s->in.q = fixed_vars(s->nlp, model.n_u());
+  s->in.p = fixed_vars(s->nlp, model.n_p());
+  s->in.lambda_start = fixed_vars(s->nlp, model.n_theta());
+  s->in.mu_start = fixed_vars(s->nlp, model.n_sys());
+  s->in.T = T_step;
+  // Non-stiffly-accurate schemes: boundary values (33) at the step end too, so that a switch
+  // cannot hide between the last stage and the end of the step.
+  s->in.boundary_at_end = true;
+  s->iv = std::make_unique<discretization::FesdInterval>(model, tab, d);
+  s->iv->build(s->nlp, s->in);
+  s->comp_rows = mpcc::add_scholtes_rows(s->nlp, s->iv->groups());
+  return s;
+}
+
 }  // namespace
 
 std::vector<double> IntegratorResult::switch_times() const {
@@ -89,20 +116,14 @@ IntegratorResult integrate(const Pss& model, const Eigen::VectorXd& x0_in, doubl
   const double T_step = T_sim / N_sim;
 
   // ---- the NLP of one step ----
-  nlp::BlockNlp nlp;
-  discretization::IntervalInputs in;
-  in.s0 = fixed_vars(nlp, n_x);
-  in.q = fixed_vars(nlp, model.n_u());
-  in.p = fixed_vars(nlp, model.n_p());
-  in.lambda_start = fixed_vars(nlp, n_th);
-  in.mu_start = fixed_vars(nlp, n_sys);
-  in.T = T_step;
-  // Non-stiffly-accurate schemes: boundary values (33) at the step end too, so that a switch cannot
-  // hide between the last stage and the end of the step.
-  in.boundary_at_end = true;
-  discretization::FesdInterval iv(model, tab, d);
-  iv.build(nlp, in);
-  const std::vector<int> comp_rows = mpcc::add_scholtes_rows(nlp, iv.groups());
+  const std::unique_ptr<StepNlp> primary = build_step_nlp(model, tab, d, T_step);
+  nlp::BlockNlp& nlp = primary->nlp;
+  const discretization::IntervalInputs& in = primary->in;
+  const discretization::FesdInterval& iv = *primary->iv;
+  // Built on first need: the same step with the sparse cross complementarity (28), which the
+  // homotopy follows more reliably (docs/benchmarks.md). Same variable layout, other rows.
+  std::unique_ptr<StepNlp> fallback;
+  const bool can_fall_back = d.use_fesd && d.cross_comp != CrossComp::Sparse;
 
   auto xdot_at = [&](const Eigen::VectorXd& x, const Eigen::VectorXd& theta) {
     Eigen::VectorXd xd(n_x);
@@ -143,16 +164,38 @@ IntegratorResult integrate(const Pss& model, const Eigen::VectorXd& x0_in, doubl
     }
     nlp::Iterate it;
     it.x = nlp.x_init;
-    const mpcc::HomotopyResult hr =
-        mpcc::solve_homotopy(nlp, comp_rows, iv.residual_pairs(), solver, it, options.homotopy);
+    mpcc::HomotopyResult hr = mpcc::solve_homotopy(nlp, primary->comp_rows, iv.residual_pairs(),
+                                                   solver, it, options.homotopy);
+    std::vector<HomotopyRow> rows = hr.rows;
+    auto account = [&](const mpcc::HomotopyResult& h) {
+      res.summary.homotopy_steps += static_cast<int>(h.rows.size());
+      res.summary.nlp_iterations += h.nlp_iterations;
+      res.summary.derivative_s += h.eval_s;
+      res.summary.solver_s += h.solver_s;
+    };
+    account(hr);
+    if (hr.status != Status::Success && can_fall_back) {  // same start, sparse form (28)
+      if (!fallback) {
+        DiscretizationOptions sparse = d;
+        sparse.cross_comp = CrossComp::Sparse;
+        fallback = build_step_nlp(model, tab, sparse, T_step);
+      }
+      fallback->nlp.x_lb = nlp.x_lb;  // same layout: fixed inputs and bounds carry over
+      fallback->nlp.x_ub = nlp.x_ub;
+      fallback->nlp.x_init = nlp.x_init;
+      if (!fallback->nlp.finalized()) fallback->nlp.finalize();
+      nlp::Iterate retry;
+      retry.x = nlp.x_init;
+      hr = mpcc::solve_homotopy(fallback->nlp, fallback->comp_rows, fallback->iv->residual_pairs(),
+                                solver, retry, options.homotopy);
+      account(hr);
+      rows.insert(rows.end(), hr.rows.begin(), hr.rows.end());
+      ++res.summary.fallback_steps;
+      it = std::move(retry);
+    }
     nlp.x_init = it.x;  // the solution: read below and the base of the next guess
     const std::vector<double>& w = it.x;
-
-    res.homotopy.push_back(hr.rows);
-    res.summary.homotopy_steps += static_cast<int>(hr.rows.size());
-    res.summary.nlp_iterations += hr.nlp_iterations;
-    res.summary.derivative_s += hr.eval_s;
-    res.summary.solver_s += hr.solver_s;
+    res.homotopy.push_back(std::move(rows));
     res.summary.max_comp_residual = std::max(res.summary.max_comp_residual, hr.comp_residual);
 
     for (int n = 0; n < N_FE; ++n) {
@@ -246,6 +289,9 @@ std::string IntegratorResult::full_report() const {
   os << fmt::format("  IPOPT iterations     {}  ({:.1f} per step)\n", summary.nlp_iterations,
                     summary.nlp_iterations / steps);
   os << fmt::format("  max comp. residual   {:.2e}\n", summary.max_comp_residual);
+  if (summary.fallback_steps > 0)
+    os << fmt::format("  retried steps        {}  (sparse cross complementarity (28))\n",
+                      summary.fallback_steps);
   os << fmt::format("  wall time            {:.3f} s  ({:.2f} ms per step)\n", summary.wall_s,
                     1e3 * summary.wall_s / steps);
   const double busy = summary.derivative_s + summary.solver_s;

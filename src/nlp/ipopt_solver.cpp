@@ -179,7 +179,7 @@ class BlockTnlp final : public Ipopt::TNLP {
 
 /// Largest KKT dimension (n + m) solved with the dense LDL' solver; above it MUMPS. Dense costs
 /// (n + m)^3 / 3 flops per factorization, MUMPS a fixed ~0.5 ms per call (docs/benchmarks.md).
-constexpr int kDenseKktMax = 300;
+constexpr int kDenseKktMax = 128;
 
 /// Loads libfesd_dense_kkt.so (next to libfesd.so) globally, so that IPOPT's loader, which opens
 /// "libhsl.so" for linear_solver = ma27, finds it by its SONAME. Once per process.

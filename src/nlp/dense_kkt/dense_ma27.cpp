@@ -15,8 +15,6 @@
 extern "C" {
 void dsytrf_(const char* uplo, const int* n, double* a, const int* lda, int* ipiv, double* work,
              const int* lwork, int* info);
-void dsytrs_(const char* uplo, const int* n, const int* nrhs, const double* a, const int* lda,
-             const int* ipiv, double* b, const int* ldb, int* info);
 
 void ma27id_(int* icntl, double* cntl);
 void ma27ad_(const int* n, const int* nz, const int* irn, const int* icn, int* iw, const int* liw,
@@ -145,14 +143,66 @@ void ma27bd_(const int* n_in, const int* nz_in, const int* irn, const int* icn, 
   }
 }
 
+namespace {
+/// Solves (L D L') x = b in place for dsytrf's lower factor F (column-major, leading dimension n)
+/// and pivots ipiv: the steps of LAPACK's dsytrs with UPLO = 'L', as plain loops. On Debian's
+/// reference BLAS, dsytrs' per-column dgemv/dger calls dominated IPOPT's back-solves.
+void ldlt_solve(int n, const double* F, const int* ipiv, double* b) {
+  auto L = [&](int i, int j) { return F[static_cast<std::size_t>(j) * n + i]; };
+  // Forward: solve L D y = P b.
+  for (int k = 0; k < n;) {
+    if (ipiv[k] > 0) {
+      const int kp = ipiv[k] - 1;
+      std::swap(b[k], b[kp]);
+      const double bk = b[k];
+      const double* col = F + static_cast<std::size_t>(k) * n;
+      for (int i = k + 1; i < n; ++i) b[i] -= col[i] * bk;
+      b[k] /= L(k, k);
+      k += 1;
+    } else {
+      const int kp = -ipiv[k] - 1;
+      std::swap(b[k + 1], b[kp]);
+      const double b0 = b[k], b1 = b[k + 1];
+      const double* c0 = F + static_cast<std::size_t>(k) * n;
+      const double* c1 = F + static_cast<std::size_t>(k + 1) * n;
+      for (int i = k + 2; i < n; ++i) b[i] -= c0[i] * b0 + c1[i] * b1;
+      const double d21 = L(k + 1, k);
+      const double d11 = L(k, k) / d21, d22 = L(k + 1, k + 1) / d21;
+      const double denom = d11 * d22 - 1.0;
+      const double y0 = b0 / d21, y1 = b1 / d21;
+      b[k] = (d22 * y0 - y1) / denom;
+      b[k + 1] = (d11 * y1 - y0) / denom;
+      k += 2;
+    }
+  }
+  // Backward: solve L' P' x = y.
+  for (int k = n - 1; k >= 0;) {
+    const double* col = F + static_cast<std::size_t>(k) * n;
+    double s = 0.0;
+    for (int i = k + 1; i < n; ++i) s += col[i] * b[i];
+    b[k] -= s;
+    if (ipiv[k] > 0) {
+      std::swap(b[k], b[ipiv[k] - 1]);
+      k -= 1;
+    } else {
+      const double* prev = F + static_cast<std::size_t>(k - 1) * n;
+      double t = 0.0;
+      for (int i = k + 1; i < n; ++i) t += prev[i] * b[i];
+      b[k - 1] -= t;
+      std::swap(b[k], b[-ipiv[k] - 1]);
+      k -= 2;
+    }
+  }
+}
+}  // namespace
+
 void ma27cd_(const int* n_in, double* a, const int*, int* iw, const int*, double*, const int*,
              double* rhs, int*, const int*, int*, double*) {
-  const int n = *n_in, one = 1;
+  const int n = *n_in;
   // The factor sits behind the NZ input values; recover NZ from the layout IW = [pivots | NZ].
   const int nz = iw[n];
-  int lapack_info = 0;
   const double* scale = a + nz + static_cast<std::size_t>(n) * n;
   for (int i = 0; i < n; ++i) rhs[i] *= scale[i];  // (S A S) y = S b, x = S y
-  dsytrs_("L", &n, &one, a + nz, &n, iw, rhs, &n, &lapack_info);
+  ldlt_solve(n, a + nz, iw, rhs);
   for (int i = 0; i < n; ++i) rhs[i] *= scale[i];
 }
