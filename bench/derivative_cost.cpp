@@ -17,21 +17,9 @@
 #include "discretization/fesd_interval.hpp"
 #include "fesd/model.hpp"
 #include "mpcc/homotopy.hpp"
+#include "oscillator_model.hpp"
 
 namespace {
-
-struct Oscillator {  // eq. (47)
-  template <class T>
-  void c(const T* x, const T*, T* c) const {
-    c[0] = x[0] * x[0] + x[1] * x[1] - 1.0;
-  }
-  template <class T>
-  void f(int region, const T* x, const T*, const T*, T* f) const {
-    const double w = 2 * std::numbers::pi, s = region == 0 ? -1.0 : 1.0;
-    f[0] = x[0] + s * w * x[1];
-    f[1] = -s * w * x[0] + x[1];
-  }
-};
 
 struct SlidingOcp {  // the dynamics of (61): q' = -sign(c(q)) + v, v' = u, two subsystems
   template <class T>
@@ -41,7 +29,7 @@ struct SlidingOcp {  // the dynamics of (61): q' = -sign(c(q)) + v, v' = u, two 
   }
   template <class T>
   void f(int r, const T* x, const T* u, const T*, T* f) const {
-    const int k = r / 2;                  // subsystem
+    const int k = r / 2;                       // subsystem
     const double s = r % 2 == 0 ? 1.0 : -1.0;  // sign of c_k in this region
     for (int i = 0; i < 4; ++i) f[i] = T(0.0);
     f[k] = -s + x[2 + k];
@@ -102,13 +90,19 @@ nlohmann::json measure(const char* name, const fesd::Pss& model, int n_s, int N_
   const int R = 200;
   const auto tg = time_it(R, [&] { nlp.eval_g(nlp.x_init.data(), g.data()); });
   const auto tj = time_it(R, [&] { nlp.eval_jac_g(nlp.x_init.data(), jac.data()); });
-  const auto th = time_it(R, [&] { nlp.eval_h(nlp.x_init.data(), 1.0, lambda.data(), hess.data()); });
+  const auto th =
+      time_it(R, [&] { nlp.eval_h(nlp.x_init.data(), 1.0, lambda.data(), hess.data()); });
   std::printf("%-28s %6d %6d %8d %8d %10.1f %10.1f %10.1f %10.1f\n", name, nlp.num_variables(),
-              nlp.num_constraints(), nlp.jac_nnz(), nlp.hess_nnz(), 1e6 * tg.first,
-              1e6 * tj.first, 1e6 * th.first, 1e6 * t_fin.first);
-  return {{"problem", name},      {"n", nlp.num_variables()}, {"m", nlp.num_constraints()},
-          {"jac_nnz", nlp.jac_nnz()}, {"hess_nnz", nlp.hess_nnz()}, {"eval_g_us", 1e6 * tg.first},
-          {"eval_jac_us", 1e6 * tj.first}, {"eval_h_us", 1e6 * th.first},
+              nlp.num_constraints(), nlp.jac_nnz(), nlp.hess_nnz(), 1e6 * tg.first, 1e6 * tj.first,
+              1e6 * th.first, 1e6 * t_fin.first);
+  return {{"problem", name},
+          {"n", nlp.num_variables()},
+          {"m", nlp.num_constraints()},
+          {"jac_nnz", nlp.jac_nnz()},
+          {"hess_nnz", nlp.hess_nnz()},
+          {"eval_g_us", 1e6 * tg.first},
+          {"eval_jac_us", 1e6 * tj.first},
+          {"eval_h_us", 1e6 * th.first},
           {"finalize_us", 1e6 * t_fin.first}};
 }
 
@@ -118,12 +112,13 @@ int main(int argc, char** argv) {
   std::string json_path;
   for (int i = 1; i + 1 < argc; ++i)
     if (std::string(argv[i]) == "--json") json_path = argv[i + 1];
-  const fesd::Pss osc = fesd::make_pss(
-      Oscillator{}, fesd::PssDims{.n_x = 2, .subsystems = {fesd::Subsystem::from_c(1)}});
+  const fesd::Pss osc = fesd_bench::oscillator_model();  // eq. (47)
   const fesd::Pss ocp = fesd::make_pss(
-      SlidingOcp{}, fesd::PssDims{.n_x = 4, .n_u = 2,
-                                  .subsystems = {fesd::Subsystem::from_c(1, Eigen::MatrixXd{{1}, {-1}}),
-                                                 fesd::Subsystem::from_c(1, Eigen::MatrixXd{{1}, {-1}})}});
+      SlidingOcp{},
+      fesd::PssDims{.n_x = 4,
+                    .n_u = 2,
+                    .subsystems = {fesd::Subsystem::from_c(1, Eigen::MatrixXd{{1}, {-1}}),
+                                   fesd::Subsystem::from_c(1, Eigen::MatrixXd{{1}, {-1}})}});
   // The second subsystem's c is c[1]: c() fills both subsystems' switching functions in order.
   std::printf("%-28s %6s %6s %8s %8s %10s %10s %10s %10s\n", "problem (median of 200)", "n", "m",
               "jac_nnz", "hess_nnz", "g [us]", "jac [us]", "hess [us]", "setup [us]");

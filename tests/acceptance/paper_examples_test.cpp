@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "../../bench/oscillator_model.hpp"
 #include "fesd/integrator.hpp"
 #include "fesd/model.hpp"
 #include "support/compare.hpp"
@@ -147,27 +148,12 @@ TEST(Spontaneous, ReturnsOneValidSolution) {
     EXPECT_NEAR(std::abs(r.x[n][0]), std::max(0.0, r.t[n] - t_star), 1e-6) << "at t = " << r.t[n];
 }
 
-// The oscillator (47) as printed; exact x(T) from REFERENCE.md, switch at t_s = 1.
-struct Oscillator {
-  template <class T>
-  void c(const T* x, const T*, T* c) const {
-    c[0] = x[0] * x[0] + x[1] * x[1] - 1.0;
-  }
-  template <class T>
-  void f(int region, const T* x, const T*, const T*, T* f) const {
-    const double w = 2 * std::numbers::pi;
-    const double s = region == 0 ? -1.0 : 1.0;  // region 0: c > 0 (outside): A2; region 1: A1
-    f[0] = x[0] + s * w * x[1];
-    f[1] = -s * w * x[0] + x[1];
-  }
-};
+// The oscillator (47) as printed (bench/oscillator_model.hpp); exact x(T) from REFERENCE.md.
 
 TEST(Oscillator, FesdRadau3MatchesExactSolution) {
-  const fesd::Pss model = fesd::make_pss(
-      Oscillator{}, fesd::PssDims{.n_x = 2, .subsystems = {fesd::Subsystem::from_c(1)}});
-  Eigen::VectorXd x0(2), x_exact(2);
-  x0 << std::exp(-1.0), 0.0;
-  x_exact << -1.5974603774506984, -0.7614936206060108;
+  const fesd::Pss model = fesd_bench::oscillator_model();
+  const Eigen::VectorXd x0 = fesd_bench::oscillator_x0(),
+                        x_exact = fesd_bench::oscillator_exact_xT();
   const auto r =
       fesd::integrate(model, x0, std::numbers::pi / 2, 20, options(RkScheme::RadauIIA, 3));
   ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
@@ -189,11 +175,9 @@ namespace {
 // order 5: measured error 1.1e-3 at this h; 5e-3 keeps a margin without admitting order 1 (the
 // standard method: 0.4).
 TEST(Oscillator, CoarseStepsSucceedThroughTheSparseRetry) {
-  const fesd::Pss model = fesd::make_pss(
-      Oscillator{}, fesd::PssDims{.n_x = 2, .subsystems = {fesd::Subsystem::from_c(1)}});
-  Eigen::VectorXd x0(2), x_exact(2);
-  x0 << std::exp(-1.0), 0.0;
-  x_exact << -1.5974603774506984, -0.7614936206060108;
+  const fesd::Pss model = fesd_bench::oscillator_model();
+  const Eigen::VectorXd x0 = fesd_bench::oscillator_x0(),
+                        x_exact = fesd_bench::oscillator_exact_xT();
   const auto r =
       fesd::integrate(model, x0, std::numbers::pi / 2, 8, options(RkScheme::RadauIIA, 3));
   ASSERT_EQ(r.status, fesd::Status::Success)

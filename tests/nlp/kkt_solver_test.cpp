@@ -5,30 +5,16 @@
 
 #include <gtest/gtest.h>
 
+#include "../../bench/oscillator_model.hpp"
 #include "fesd/integrator.hpp"
 #include "fesd/model.hpp"
 #include "support/compare.hpp"
 
 namespace {
 
-struct Oscillator {  // eq. (47)
-  template <class T>
-  void c(const T* x, const T*, T* c) const {
-    c[0] = x[0] * x[0] + x[1] * x[1] - 1.0;
-  }
-  template <class T>
-  void f(int region, const T* x, const T*, const T*, T* f) const {
-    const double w = 2 * std::numbers::pi, s = region == 0 ? -1.0 : 1.0;
-    f[0] = x[0] + s * w * x[1];
-    f[1] = -s * w * x[0] + x[1];
-  }
-};
-
 TEST(KktSolver, DenseAndMumpsGiveTheSameIntegration) {
-  const fesd::Pss model = fesd::make_pss(
-      Oscillator{}, fesd::PssDims{.n_x = 2, .subsystems = {fesd::Subsystem::from_c(1)}});
-  Eigen::VectorXd x0(2);
-  x0 << std::exp(-1.0), 0.0;
+  const fesd::Pss model = fesd_bench::oscillator_model();
+  const Eigen::VectorXd x0 = fesd_bench::oscillator_x0();
   fesd::IntegratorOptions automatic, mumps;
   automatic.discretization.n_s = mumps.discretization.n_s = 3;
   mumps.nlp.extra = {{"linear_solver", "mumps"}};
