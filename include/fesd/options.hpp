@@ -58,7 +58,9 @@ struct HomotopyOptions {
   double homotopy_update_slope = 0.1;  ///< `homotopy_update_slope` in (0, 1)
   double sigma_N = 1e-12;              ///< `sigma_N` > 0: smallest sigma used
   double complementarity_tol = 1e-9;   ///< `complementarity_tol` > 0: stop when residual <= this
-  int max_homotopy_steps = 20;         ///< `N_homotopy` >= 1: maximum number of NLPs per solve
+  /// `N_homotopy`: maximum number of NLPs per solve, 0..1000. 0 (default): enough for sigma to
+  /// reach sigma_N, ceil(log(sigma_N / sigma_0) / log(slope)) + 1 (13 with the defaults).
+  int max_homotopy_steps = 0;
 };
 
 /// IPOPT options (problem-file table [ipopt]). Any other IPOPT option can be passed by name.

@@ -84,8 +84,9 @@ std::vector<std::string> validate(const HomotopyOptions& o) {
           fmt::format("homotopy.sigma_N = {}: must be <= sigma_0 = {}", o.sigma_N, o.sigma_0));
   require(e, finite_positive(o.complementarity_tol),
           fmt::format("homotopy.complementarity_tol = {}: must be > 0", o.complementarity_tol));
-  require(e, o.max_homotopy_steps >= 1 && o.max_homotopy_steps <= 1000,
-          fmt::format("homotopy.N_homotopy = {}: must be in 1..1000", o.max_homotopy_steps));
+  require(e, o.max_homotopy_steps >= 0 && o.max_homotopy_steps <= 1000,
+          fmt::format("homotopy.N_homotopy = {}: must be in 0..1000 (0: automatic)",
+                      o.max_homotopy_steps));
   return e;
 }
 

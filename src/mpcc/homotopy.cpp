@@ -61,7 +61,11 @@ HomotopyResult solve_homotopy(nlp::BlockNlp& nlp, const std::vector<int>& comp_r
   HomotopyResult res;
   double sigma = o.sigma_0;
   bool last_ok = false, eval_failed = false;
-  for (int k = 0; k < o.max_homotopy_steps; ++k) {
+  int max_steps = o.max_homotopy_steps;
+  if (max_steps == 0)  // automatic: until sigma reaches sigma_N
+    max_steps = 1 + static_cast<int>(std::ceil(std::log(o.sigma_N / o.sigma_0) /
+                                                std::log(o.homotopy_update_slope) - 1e-9));
+  for (int k = 0; k < max_steps; ++k) {
     set_sigma(nlp, comp_rows, sigma);
     const nlp::NlpResult r = solver.solve(nlp, it, /*warm_start=*/k > 0);
     res.comp_residual = comp_residual(it.x.data(), residual_pairs);

@@ -131,14 +131,14 @@ x0 = [0]
 T_sim = 1
 [homotopy]
 sigma_0 = -1.0
-N_homotopy = 0
+N_homotopy = -1
 )toml",
                              "two.toml");
   });
   EXPECT_EQ(o.kind, "InvalidOption");
   EXPECT_NE(o.message.find("two.toml:10: homotopy.sigma_0 = -1: must be > 0"), std::string::npos)
       << o.message;
-  EXPECT_NE(o.message.find("two.toml:11: homotopy.N_homotopy = 0: must be in 1..1000"),
+  EXPECT_NE(o.message.find("two.toml:11: homotopy.N_homotopy = -1: must be in 0..1000"),
             std::string::npos)
       << o.message;
 }
