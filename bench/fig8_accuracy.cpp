@@ -36,11 +36,17 @@
 #include <fesd/options.hpp>
 #include <fesd/tableau.hpp>
 
+#include "bench_args.hpp"
 #include "oscillator_model.hpp"
 
 namespace {
 
 using fesd::RkScheme;
+using fesd_bench::parse_double;
+using fesd_bench::parse_int;
+using fesd_bench::parse_list;
+using fesd_bench::split;
+using fesd_bench::usage;
 
 constexpr double kFitLow = 1e-10;  // below: round-off of NLPs solved to tol = 1e-12
 constexpr double kFitHigh = 1e-1;  // above: pre-asymptotic (h too large); FESD only
@@ -155,54 +161,6 @@ std::string fmt_opt(const std::optional<double>& v, const char* spec = "{:.2f}")
   return v ? fmt::format(fmt::runtime(spec), *v) : std::string("-");
 }
 
-std::vector<std::string> split(std::string_view s, char sep) {
-  std::vector<std::string> out;
-  std::string cur;
-  for (char ch : s) {
-    if (ch == sep) {
-      if (!cur.empty()) out.push_back(cur);
-      cur.clear();
-    } else {
-      cur += ch;
-    }
-  }
-  if (!cur.empty()) out.push_back(cur);
-  return out;
-}
-
-[[noreturn]] void usage(const std::string& why, int exit_code = 2) {
-  std::fprintf(stderr,
-               "fig8_accuracy: %s\n"
-               "usage: fig8_accuracy [--quick] [--methods scheme[:n_s],...] [--N n1,n2,...]\n"
-               "                     [--mode both|fesd|std] [--comp-tol X] [--sigma-N X]\n"
-               "                     [--ipopt-tol X] [--csv FILE] [--json FILE]\n"
-               "schemes: radau_iia gauss_legendre lobatto_iiia lobatto_iiic explicit_rk\n",
-               why.c_str());
-  std::exit(exit_code);
-}
-
-double parse_double(const std::string& flag, const std::string& v) {
-  try {
-    std::size_t pos = 0;
-    const double d = std::stod(v, &pos);
-    if (pos != v.size() || !(d > 0)) throw std::invalid_argument(v);
-    return d;
-  } catch (const std::exception&) {
-    usage(fmt::format("{} {}: expected a positive number", flag, v));
-  }
-}
-
-int parse_int(const std::string& flag, const std::string& v) {
-  try {
-    std::size_t pos = 0;
-    const int i = std::stoi(v, &pos);
-    if (pos != v.size() || i < 1) throw std::invalid_argument(v);
-    return i;
-  } catch (const std::exception&) {
-    usage(fmt::format("{} {}: expected a positive integer", flag, v));
-  }
-}
-
 struct Config {
   std::vector<Method> methods;
   std::vector<int> N;
@@ -257,7 +215,7 @@ Config parse_args(int argc, char** argv) {
   if (N_arg.empty()) {
     cfg.N = cfg.quick ? std::vector<int>{8, 16, 32} : std::vector<int>{8, 11, 16, 23, 32, 45, 64};
   } else {
-    for (const std::string& s : split(N_arg, ',')) cfg.N.push_back(parse_int("--N", s));
+    cfg.N = parse_list("--N", N_arg);
   }
   std::sort(cfg.N.begin(), cfg.N.end());
   cfg.N.erase(std::unique(cfg.N.begin(), cfg.N.end()), cfg.N.end());
@@ -331,6 +289,17 @@ std::string cell(const Run& r, bool t_s) {
 }
 
 }  // namespace
+
+void fesd_bench::usage(const std::string& why, int exit_code) {
+  std::fprintf(stderr,
+               "fig8_accuracy: %s\n"
+               "usage: fig8_accuracy [--quick] [--methods scheme[:n_s],...] [--N n1,n2,...]\n"
+               "                     [--mode both|fesd|std] [--comp-tol X] [--sigma-N X]\n"
+               "                     [--ipopt-tol X] [--csv FILE] [--json FILE]\n"
+               "schemes: radau_iia gauss_legendre lobatto_iiia lobatto_iiic explicit_rk\n",
+               why.c_str());
+  std::exit(exit_code);
+}
 
 int main(int argc, char** argv) {
   const Config cfg = parse_args(argc, argv);

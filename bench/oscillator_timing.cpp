@@ -30,9 +30,15 @@
 #include <fesd/integrator.hpp>
 #include <fesd/options.hpp>
 
+#include "bench_args.hpp"
 #include "oscillator_model.hpp"
 
 namespace {
+
+using fesd_bench::parse_double;
+using fesd_bench::parse_int;
+using fesd_bench::parse_list;
+using fesd_bench::usage;
 
 /// nosnoc_py (commit 0c3f3bb, CasADi 3.6.3, IPOPT 3.11.9 + MUMPS) on a 2-core machine, from
 /// /work/shared/PEERS.md, "Oscillator (47), FESD simulation, Radau IIA, N_FE = 2, T = pi/2".
@@ -87,51 +93,6 @@ struct Config {
   double comp_tol = 1e-12, sigma_N = 1e-12;
   std::string csv, json;
 };
-
-[[noreturn]] void usage(const std::string& why, int exit_code = 2) {
-  std::fprintf(
-      stderr,
-      "oscillator_timing: %s\n"
-      "usage: oscillator_timing [--part a|b|both] [--repeat R] [--N-a N] [--stages 2,3,4]\n"
-      "                         [--N 10,20,40,80] [--comp-tol X] [--sigma-N X]\n"
-      "                         [--csv FILE] [--json FILE]\n",
-      why.c_str());
-  std::exit(exit_code);
-}
-
-int parse_int(const std::string& flag, const std::string& v) {
-  try {
-    std::size_t pos = 0;
-    const int i = std::stoi(v, &pos);
-    if (pos != v.size() || i < 1) throw std::invalid_argument(v);
-    return i;
-  } catch (const std::exception&) {
-    usage(fmt::format("{} {}: expected a positive integer", flag, v));
-  }
-}
-
-double parse_double(const std::string& flag, const std::string& v) {
-  try {
-    std::size_t pos = 0;
-    const double d = std::stod(v, &pos);
-    if (pos != v.size() || !(d > 0)) throw std::invalid_argument(v);
-    return d;
-  } catch (const std::exception&) {
-    usage(fmt::format("{} {}: expected a positive number", flag, v));
-  }
-}
-
-std::vector<int> parse_list(const std::string& flag, const std::string& v) {
-  std::vector<int> out;
-  std::size_t start = 0;
-  while (start <= v.size()) {
-    const std::size_t comma = std::min(v.find(',', start), v.size());
-    if (comma > start) out.push_back(parse_int(flag, v.substr(start, comma - start)));
-    start = comma + 1;
-  }
-  if (out.empty()) usage(flag + ": empty list");
-  return out;
-}
 
 Config parse_args(int argc, char** argv) {
   Config c;
@@ -235,6 +196,17 @@ nlohmann::json to_json(const Measurement& m, const char* part) {
 }
 
 }  // namespace
+
+void fesd_bench::usage(const std::string& why, int exit_code) {
+  std::fprintf(
+      stderr,
+      "oscillator_timing: %s\n"
+      "usage: oscillator_timing [--part a|b|both] [--repeat R] [--N-a N] [--stages 2,3,4]\n"
+      "                         [--N 10,20,40,80] [--comp-tol X] [--sigma-N X]\n"
+      "                         [--csv FILE] [--json FILE]\n",
+      why.c_str());
+  std::exit(exit_code);
+}
 
 int main(int argc, char** argv) {
   const Config cfg = parse_args(argc, argv);
