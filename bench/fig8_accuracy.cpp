@@ -10,11 +10,15 @@
 // errors scatter between ~1e-2 and ~1 at every h (they depend on where t_s = 1 falls inside an
 // element), so an upper cut would keep only the lucky points and bias the slope.
 //
-//   fig8_accuracy [--quick] [--methods radau_iia:3,gauss_legendre] [--N 8,16,32]
+//   fig8_accuracy [--quick] [--methods radau_iia:3,gauss_legendre] [--N 8,16,32] [--N-low 64,128]
 //                 [--mode both|fesd|std] [--comp-tol 1e-12] [--sigma-N 1e-13] [--ipopt-tol 1e-12]
+//                 [--stage-sign auto|all|boundary]
 //                 [--csv FILE] [--json FILE]
 //
 // A method is `scheme:n_s` or just `scheme` (all n_s of Fig. 8); scheme names as in problem files.
+// Methods of order >= 3 run at --N (default 8, 11, ..., 64); methods of order 1 and 2, whose error
+// constants are large on this problem, at --N-low (default 64, 128, ..., 1024; = --N if only --N
+// is given).
 // One progress line per run goes to stderr; the tables go to stdout.
 #include <algorithm>
 #include <cmath>
@@ -50,14 +54,19 @@ using fesd_bench::usage;
 
 constexpr double kFitLow = 1e-10;  // below: round-off of NLPs solved to tol = 1e-12
 constexpr double kFitHigh = 1e-1;  // above: pre-asymptotic (h too large); FESD only
+// First-order methods have error constants ~300 here (omega = 2 pi: explicit Euler's radius
+// grows by sqrt((1 + h)^2 + omega^2 h^2) per step), so E < 0.1 needs N_sim > 5000: their window
+// ends at 1 instead.
+constexpr double kFitHighOrder1 = 1.0;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 struct Method {
   RkScheme scheme = RkScheme::RadauIIA;
   int n_s = 1;
-  int order = 0;      // classical order for smooth ODEs
-  std::string label;  // short column label, e.g. "Radau3"
-  std::string name;   // e.g. "Radau IIA n_s=3"
+  int order = 0;       // classical order for smooth ODEs
+  std::vector<int> N;  // N_sim values run for this method
+  std::string label;   // short column label, e.g. "Radau3"
+  std::string name;    // e.g. "Radau IIA n_s=3"
 };
 
 Method make_method(RkScheme scheme, int n_s) {
@@ -163,16 +172,18 @@ std::string fmt_opt(const std::optional<double>& v, const char* spec = "{:.2f}")
 
 struct Config {
   std::vector<Method> methods;
-  std::vector<int> N;
+  std::vector<int> N;      // N_sim for methods of order >= 3
+  std::vector<int> N_low;  // N_sim for methods of order 1 and 2 (larger error constants)
   bool run_std = true, run_fesd = true;
   double comp_tol = 1e-12, sigma_N = 1e-13, ipopt_tol = 1e-12;
+  fesd::StageLambdaSign stage_sign = fesd::StageLambdaSign::Auto;
   std::string csv, json;
   bool quick = false;
 };
 
 Config parse_args(int argc, char** argv) {
   Config cfg;
-  std::string methods_arg, N_arg;
+  std::string methods_arg, N_arg, N_low_arg;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto value = [&]() -> std::string {
@@ -185,6 +196,8 @@ Config parse_args(int argc, char** argv) {
       methods_arg = value();
     } else if (a == "--N") {
       N_arg = value();
+    } else if (a == "--N-low") {
+      N_low_arg = value();
     } else if (a == "--mode") {
       const std::string m = value();
       if (m == "both") {
@@ -196,6 +209,10 @@ Config parse_args(int argc, char** argv) {
       } else {
         usage("--mode " + m + ": expected both, fesd or std");
       }
+    } else if (a == "--stage-sign") {
+      const std::string v = value();
+      if (!fesd::parse(v, cfg.stage_sign))
+        usage("--stage-sign " + v + ": expected all, boundary or auto");
     } else if (a == "--comp-tol") {
       cfg.comp_tol = parse_double(a, value());
     } else if (a == "--sigma-N") {
@@ -217,8 +234,16 @@ Config parse_args(int argc, char** argv) {
   } else {
     cfg.N = parse_list("--N", N_arg);
   }
-  std::sort(cfg.N.begin(), cfg.N.end());
-  cfg.N.erase(std::unique(cfg.N.begin(), cfg.N.end()), cfg.N.end());
+  if (!N_low_arg.empty())
+    cfg.N_low = parse_list("--N-low", N_low_arg);
+  else if (!N_arg.empty() || cfg.quick)
+    cfg.N_low = cfg.N;
+  else
+    cfg.N_low = {64, 128, 256, 512, 1024};
+  for (auto* v : {&cfg.N, &cfg.N_low}) {
+    std::sort(v->begin(), v->end());
+    v->erase(std::unique(v->begin(), v->end()), v->end());
+  }
 
   if (methods_arg.empty())
     methods_arg = cfg.quick
@@ -237,6 +262,7 @@ Config parse_args(int argc, char** argv) {
     for (int n_s : stages) {
       try {
         cfg.methods.push_back(make_method(scheme, n_s));
+        cfg.methods.back().N = cfg.methods.back().order <= 2 ? cfg.N_low : cfg.N;
       } catch (const fesd::Error& e) {
         usage(item + ": " + e.what());
       }
@@ -251,6 +277,7 @@ Run run_one(const Method& m, bool use_fesd, int N_sim, const Config& cfg) {
   opt.discretization.n_s = m.n_s;
   opt.discretization.N_FE = 2;  // as in the paper
   opt.discretization.use_fesd = use_fesd;
+  opt.discretization.stage_lambda_sign = cfg.stage_sign;
   opt.homotopy.complementarity_tol = cfg.comp_tol;
   opt.homotopy.sigma_N = cfg.sigma_N;
   opt.nlp.tol = cfg.ipopt_tol;
@@ -291,13 +318,15 @@ std::string cell(const Run& r, bool t_s) {
 }  // namespace
 
 void fesd_bench::usage(const std::string& why, int exit_code) {
-  std::fprintf(stderr,
-               "fig8_accuracy: %s\n"
-               "usage: fig8_accuracy [--quick] [--methods scheme[:n_s],...] [--N n1,n2,...]\n"
-               "                     [--mode both|fesd|std] [--comp-tol X] [--sigma-N X]\n"
-               "                     [--ipopt-tol X] [--csv FILE] [--json FILE]\n"
-               "schemes: radau_iia gauss_legendre lobatto_iiia lobatto_iiic explicit_rk\n",
-               why.c_str());
+  std::fprintf(
+      stderr,
+      "fig8_accuracy: %s\n"
+      "usage: fig8_accuracy [--quick] [--methods scheme[:n_s],...] [--N n1,...] [--N-low n1,...]\n"
+      "                     [--mode both|fesd|std] [--comp-tol X] [--sigma-N X]\n"
+      "                     [--stage-sign auto|all|boundary]\n"
+      "                     [--ipopt-tol X] [--csv FILE] [--json FILE]\n"
+      "schemes: radau_iia gauss_legendre lobatto_iiia lobatto_iiic explicit_rk\n",
+      why.c_str());
   std::exit(exit_code);
 }
 
@@ -309,13 +338,20 @@ int main(int argc, char** argv) {
 
   // runs[method][mode][N]
   std::vector<std::vector<std::vector<Run>>> runs(cfg.methods.size());
-  const std::size_t total = cfg.methods.size() * modes.size() * cfg.N.size();
+  std::size_t total = 0;
+  std::vector<int> all_N;  // table rows: every N_sim any method ran
+  for (const Method& m : cfg.methods) {
+    total += modes.size() * m.N.size();
+    all_N.insert(all_N.end(), m.N.begin(), m.N.end());
+  }
+  std::sort(all_N.begin(), all_N.end());
+  all_N.erase(std::unique(all_N.begin(), all_N.end()), all_N.end());
   std::size_t done = 0;
   double total_wall = 0;
   for (std::size_t mi = 0; mi < cfg.methods.size(); ++mi) {
     for (bool f : modes) {
       runs[mi].emplace_back();
-      for (int N : cfg.N) {
+      for (int N : cfg.methods[mi].N) {
         const Run r = run_one(cfg.methods[mi], f, N, cfg);
         ++done;
         total_wall += r.wall_s;
@@ -345,11 +381,13 @@ int main(int argc, char** argv) {
       std::string head = fmt::format("{:>5} {:>8}", "N_sim", "h");
       for (const Method& m : cfg.methods) head += fmt::format(" {:>9}", m.label);
       fmt::print("{}\n", head);
-      for (std::size_t j = 0; j < cfg.N.size(); ++j) {
-        std::string line =
-            fmt::format("{:>5} {:>8.4f}", cfg.N[j], fesd_bench::kOscillatorT / cfg.N[j]);
-        for (std::size_t mi = 0; mi < cfg.methods.size(); ++mi)
-          line += fmt::format(" {:>9}", cell(runs[mi][k][j], t_s));
+      for (int N : all_N) {
+        std::string line = fmt::format("{:>5} {:>8.4f}", N, fesd_bench::kOscillatorT / N);
+        for (std::size_t mi = 0; mi < cfg.methods.size(); ++mi) {
+          const auto& rs = runs[mi][k];
+          auto it = std::find_if(rs.begin(), rs.end(), [&](const Run& r) { return r.N_sim == N; });
+          line += fmt::format(" {:>9}", it == rs.end() ? std::string("") : cell(*it, t_s));
+        }
         fmt::print("{}\n", line);
       }
     }
@@ -359,8 +397,9 @@ int main(int argc, char** argv) {
   nlohmann::json jsum = nlohmann::json::array();
   fmt::print(
       "\nSlopes of log E (and of log |t_s - 1|) against log h, least squares; (k) = points used."
-      "\nFESD: {:.0e} < E < {:.0e}; standard: all points with E > {:.0e} (its errors scatter)\n",
-      kFitLow, kFitHigh, kFitLow);
+      "\nFESD: {:.0e} < E < {:.0e} ({:.0e} for order 1); standard: all points with E > {:.0e} (its "
+      "errors scatter)\n",
+      kFitLow, kFitHigh, kFitHighOrder1, kFitLow);
   fmt::print("{:<22} {:>5} {:>10} {:>10} {:>9} {:>10} {:>10}  {:<26} {:>8}\n", "method", "order",
              "std", "FESD", "FESD-ord", "t_s FESD", "t_s std", "FESD local slopes", "wall s");
   for (std::size_t mi = 0; mi < cfg.methods.size(); ++mi) {
@@ -379,7 +418,8 @@ int main(int argc, char** argv) {
         ex.emplace_back(r.h, r.err.x_T);
         if (r.err.t_s) et.emplace_back(r.h, *r.err.t_s);
       }
-      const double high = modes[k] ? kFitHigh : kInf;  // see the top of this file
+      const double high =  // see the top of this file
+          modes[k] ? (m.order == 1 ? kFitHighOrder1 : kFitHigh) : kInf;
       fx[modes[k] ? 1 : 0] = fit_slope(ex, high);
       ft[modes[k] ? 1 : 0] = fit_slope(et, high);
     }

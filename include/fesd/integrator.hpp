@@ -50,9 +50,14 @@ struct Summary {
   /// Steps whose homotopy failed with the chosen cross_comp_mode and were solved again with the
   /// sparse form (28) from the same start (their rows follow in `homotopy`).
   int fallback_steps = 0;
+  /// Steps that failed in both forms and were replaced by two half steps (recursively, at most
+  /// twice: quarter steps). Each half step has N_FE elements of its own, so the grid then has
+  /// more than N_sim * N_FE elements.
+  int split_steps = 0;
 };
 
-/// The result of integrate(). Time grid = all finite-element boundaries t_0 < ... < t_{N_sim N_FE}.
+/// The result of integrate(). Time grid = all finite-element boundaries t_0 < ... < t_{N_sim N_FE}
+/// (more elements where steps were split, Summary::split_steps).
 struct IntegratorResult {
   Status status = Status::NotRun;
   std::string message = "integrate() was not called";
@@ -69,7 +74,8 @@ struct IntegratorResult {
   std::vector<std::vector<int>> active_set;
   std::vector<SwitchEvent> switches;
 
-  /// One homotopy per integration step.
+  /// One homotopy per solve attempt: one per integration step, more where a step was retried as
+  /// half steps (Summary::split_steps; the failed attempt comes first).
   std::vector<std::vector<HomotopyRow>> homotopy;
   Summary summary;
 

@@ -1,6 +1,6 @@
 // include/fesd/options.hpp: discretization, homotopy and NLP options. Plain structs with documented
 // defaults; validate() lists every broken rule. Problem-file keys (nosnoc's names where nosnoc has
-// one) are given beside each field; docs/options.md is the full table.
+// one) are given beside each field; docs/problem-files.md is the full table.
 #pragma once
 #include <string>
 #include <string_view>
@@ -38,21 +38,41 @@ enum class StepEq {
 std::string_view to_string(StepEq v);
 bool parse(std::string_view name, StepEq& out);
 
+/// Where the stage LPs (9) keep their sign condition lambda >= 0 (FESD only).
+enum class StageLambdaSign {
+  /// lambda >= 0 at every stage point: the paper's (32).
+  All,
+  /// lambda >= 0 only at the points that approximate x(t_n) to the order of the scheme: element
+  /// boundaries (the last stage of a stiffly accurate scheme, the boundary values (33) otherwise).
+  /// At the other stages lambda is free and only theta * lambda = 0 per stage remains, so the
+  /// element's active set comes from its boundaries and sliding stages still satisfy g_i = g_j.
+  /// For schemes of low stage order (Lobatto IIIC, explicit RK), whose stage *states* can leave
+  /// the region of the element's vector field by O(h^2) next to a switch (docs/formulation.md).
+  Boundary,
+  /// Boundary for Lobatto IIIC and explicit RK, All otherwise (default).
+  Auto,
+};
+/// Problem-file key `stage_lambda_sign`: "all", "boundary", "auto".
+std::string_view to_string(StageLambdaSign v);
+bool parse(std::string_view name, StageLambdaSign& out);
+
 /// Discretization of one interval [0, T] (problem-file table [discretization]).
 struct DiscretizationOptions {
   RkScheme rk_scheme = RkScheme::RadauIIA;  ///< `rk_scheme`
-  int n_s = 2;                              ///< `n_s`: RK stages, >= 1 (Lobatto >= 2, explicit <= 4)
-  int N_FE = 2;        ///< `N_finite_elements`: finite elements per step, >= 1 (>= 2 for FESD)
-  bool use_fesd = true;                     ///< `use_fesd`: false = standard time-stepping (26)
-  CrossComp cross_comp = CrossComp::StageSum;     ///< `cross_comp_mode`
-  StepEq step_eq = StepEq::HeuristicMean;         ///< `step_equilibration`
+  int n_s = 2;           ///< `n_s`: RK stages, >= 1 (Lobatto >= 2, explicit <= 4)
+  int N_FE = 2;          ///< `N_finite_elements`: finite elements per step, >= 1 (>= 2 for FESD)
+  bool use_fesd = true;  ///< `use_fesd`: false = standard time-stepping (26)
+  CrossComp cross_comp = CrossComp::StageSum;                 ///< `cross_comp_mode`
+  StepEq step_eq = StepEq::HeuristicMean;                     ///< `step_equilibration`
+  StageLambdaSign stage_lambda_sign = StageLambdaSign::Auto;  ///< `stage_lambda_sign`
   double gamma_h = 1.0;  ///< `gamma_h` in (0, 1]: h_n in [(1 - gamma_h) h0, (1 + gamma_h) h0] (59f)
   double rho_h = 1.0;    ///< `rho_h` > 0: weight of the heuristic_mean penalty
 };
 
 /// The MPCC homotopy: a sequence of relaxed NLPs with theta_i lambda_i <= sigma (Scholtes),
 /// sigma_{k+1} = homotopy_update_slope * sigma_k, until the complementarity residual (the largest
-/// product of a complementarity pair, cross-complementarity pairs included) is <= complementarity_tol.
+/// product of a complementarity pair, cross-complementarity pairs included) is <=
+/// complementarity_tol.
 struct HomotopyOptions {
   double sigma_0 = 1.0;                ///< `sigma_0` > 0: first relaxation
   double homotopy_update_slope = 0.1;  ///< `homotopy_update_slope` in (0, 1)

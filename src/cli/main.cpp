@@ -90,6 +90,8 @@ constexpr OverrideKey kOverrideKeys[] = {
     {"use_fesd", "--use_fesd", "1: FESD (32), 0: standard time-stepping (26)"},
     {"cross_comp_mode", "--cross_comp_mode", "sparse, stage_sum, element or neighbor"},
     {"step_equilibration", "--step_equilibration", "none, eta, eta_tanh or heuristic_mean"},
+    {"stage_lambda_sign", "--stage_lambda_sign",
+     "where lambda >= 0 holds: all (stages), boundary (element ends) or auto"},
     {"gamma_h", "--gamma_h", "step size freedom in (0, 1]"},
     {"rho_h", "--rho_h", "weight of the heuristic_mean penalty"},
     {"sigma_0", "--sigma_0", "first homotopy relaxation"},

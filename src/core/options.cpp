@@ -40,22 +40,44 @@ constexpr std::array<std::pair<StepEq, std::string_view>, 4> kStepEq{{
     {StepEq::EtaTanh, "eta_tanh"},
     {StepEq::HeuristicMean, "heuristic_mean"},
 }};
+constexpr std::array<std::pair<StageLambdaSign, std::string_view>, 3> kStageLambdaSign{{
+    {StageLambdaSign::All, "all"},
+    {StageLambdaSign::Boundary, "boundary"},
+    {StageLambdaSign::Auto, "auto"},
+}};
 
 void require(std::vector<std::string>& out, bool ok, const std::string& what) {
   if (!ok) out.push_back(what);
 }
-bool finite_positive(double v) { return std::isfinite(v) && v > 0; }
+bool finite_positive(double v) {
+  return std::isfinite(v) && v > 0;
+}
 
 }  // namespace
 
-std::string_view to_string(CrossComp v) { return name_from(kCrossComp, v); }
-bool parse(std::string_view name, CrossComp& out) { return parse_from(kCrossComp, name, out); }
-std::string_view to_string(StepEq v) { return name_from(kStepEq, v); }
-bool parse(std::string_view name, StepEq& out) { return parse_from(kStepEq, name, out); }
+std::string_view to_string(CrossComp v) {
+  return name_from(kCrossComp, v);
+}
+bool parse(std::string_view name, CrossComp& out) {
+  return parse_from(kCrossComp, name, out);
+}
+std::string_view to_string(StepEq v) {
+  return name_from(kStepEq, v);
+}
+bool parse(std::string_view name, StepEq& out) {
+  return parse_from(kStepEq, name, out);
+}
+std::string_view to_string(StageLambdaSign v) {
+  return name_from(kStageLambdaSign, v);
+}
+bool parse(std::string_view name, StageLambdaSign& out) {
+  return parse_from(kStageLambdaSign, name, out);
+}
 
 std::vector<std::string> validate(const DiscretizationOptions& o) {
   std::vector<std::string> e;
-  const int min_s = (o.rk_scheme == RkScheme::LobattoIIIA || o.rk_scheme == RkScheme::LobattoIIIC) ? 2 : 1;
+  const int min_s =
+      (o.rk_scheme == RkScheme::LobattoIIIA || o.rk_scheme == RkScheme::LobattoIIIC) ? 2 : 1;
   const int max_s = o.rk_scheme == RkScheme::ExplicitRK ? 4 : 9;
   require(e, o.n_s >= min_s && o.n_s <= max_s,
           fmt::format("discretization.n_s = {}: must be in {}..{} for {}", o.n_s, min_s, max_s,
@@ -68,18 +90,22 @@ std::vector<std::string> validate(const DiscretizationOptions& o) {
                       o.N_FE));
   require(e, std::isfinite(o.gamma_h) && o.gamma_h > 0 && o.gamma_h <= 1,
           fmt::format("discretization.gamma_h = {}: must be in (0, 1]", o.gamma_h));
-  require(e, finite_positive(o.rho_h), fmt::format("discretization.rho_h = {}: must be > 0", o.rho_h));
+  require(e, finite_positive(o.rho_h),
+          fmt::format("discretization.rho_h = {}: must be > 0", o.rho_h));
   return e;
 }
 
 std::vector<std::string> validate(const HomotopyOptions& o) {
   std::vector<std::string> e;
-  require(e, finite_positive(o.sigma_0), fmt::format("homotopy.sigma_0 = {}: must be > 0", o.sigma_0));
-  require(e, std::isfinite(o.homotopy_update_slope) && o.homotopy_update_slope > 0 &&
-                 o.homotopy_update_slope < 1,
+  require(e, finite_positive(o.sigma_0),
+          fmt::format("homotopy.sigma_0 = {}: must be > 0", o.sigma_0));
+  require(e,
+          std::isfinite(o.homotopy_update_slope) && o.homotopy_update_slope > 0 &&
+              o.homotopy_update_slope < 1,
           fmt::format("homotopy.homotopy_update_slope = {}: must be in (0, 1)",
                       o.homotopy_update_slope));
-  require(e, finite_positive(o.sigma_N), fmt::format("homotopy.sigma_N = {}: must be > 0", o.sigma_N));
+  require(e, finite_positive(o.sigma_N),
+          fmt::format("homotopy.sigma_N = {}: must be > 0", o.sigma_N));
   require(e, !(finite_positive(o.sigma_N) && finite_positive(o.sigma_0)) || o.sigma_N <= o.sigma_0,
           fmt::format("homotopy.sigma_N = {}: must be <= sigma_0 = {}", o.sigma_N, o.sigma_0));
   require(e, finite_positive(o.complementarity_tol),

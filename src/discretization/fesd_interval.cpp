@@ -166,6 +166,11 @@ FesdInterval::FesdInterval(const Pss& model, const Tableau& tableau,
                            const DiscretizationOptions& options)
     : model_(model), tab_(tableau), opt_(options), N_FE_(options.N_FE), n_s_(tableau.n_s) {
   stiffly_accurate_ = tab_.stiffly_accurate;
+  const StageLambdaSign sign = options.stage_lambda_sign;
+  boundary_sign_ =
+      options.use_fesd && (sign == StageLambdaSign::Boundary ||
+                           (sign == StageLambdaSign::Auto &&
+                            (options.rk_scheme == RkScheme::LobattoIIIC || tab_.is_explicit)));
 }
 
 void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
@@ -192,6 +197,7 @@ void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
   lambda_end_.assign(N_FE_, {});
   boundary_vars_.assign(N_FE_, false);
   mu_end_.assign(N_FE_, {});
+  stage_signed_.assign(N_FE_ * n_s_, true);
   for (int n = 0; n < N_FE_; ++n) {
     const double h_lb = fesd ? (1.0 - opt_.gamma_h) * h0 : h0;
     const double h_ub = fesd ? (1.0 + opt_.gamma_h) * h0 : h0;
@@ -200,7 +206,10 @@ void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
       V_[idx(n, s)] = nlp.add_variables(n_x, -kInf, kInf, 0.0);
       X_[idx(n, s)] = nlp.add_variables(n_x, -kInf, kInf, 0.0);
       theta_[idx(n, s)] = nlp.add_variables(n_th, 0.0, kInf, 0.0);
-      lambda_[idx(n, s)] = nlp.add_variables(n_th, 0.0, kInf, 0.0);
+      // Boundary sign: lambda >= 0 only where the stage is the element's end point.
+      stage_signed_[idx(n, s)] = !boundary_sign_ || (stiffly_accurate_ && s == n_s_ - 1);
+      lambda_[idx(n, s)] =
+          nlp.add_variables(n_th, stage_signed_[idx(n, s)] ? 0.0 : -kInf, kInf, 0.0);
       mu_[idx(n, s)] = nlp.add_variables(n_sys, -kInf, kInf, 0.0);
     }
     if (stiffly_accurate_) {
@@ -209,7 +218,8 @@ void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
       mu_end_[n] = range(mu_[idx(n, n_s_ - 1)], n_sys);
     } else {
       x_[n + 1] = range(nlp.add_variables(n_x, -kInf, kInf, 0.0), n_x);
-      const bool boundary = fesd && (n < N_FE_ - 1 || in.boundary_at_end);
+      // With free stage lambdas every element end needs its signed boundary point.
+      const bool boundary = fesd && (n < N_FE_ - 1 || in.boundary_at_end || boundary_sign_);
       if (boundary) {
         boundary_vars_[n] =
             true;  // (33): lambda, mu at t_{n+1} from LP(x_{n+1}); theta discarded (39)
@@ -282,13 +292,31 @@ void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
     }
   }
 
+  if (in.lp_at_start) {  // (9) at s0 for lambda_{0,0}, mu_{0,0}
+    std::vector<int> lv = in.s0;
+    lv.insert(lv.end(), in.lambda_start.begin(), in.lambda_start.end());
+    lv.insert(lv.end(), in.mu_start.begin(), in.mu_start.end());
+    lv.insert(lv.end(), in.p.begin(), in.p.end());
+    nlp.add_constraint(lp, lv, 0.0, 0.0);
+  }
+
   // ---- lambda points per element: start, stages, end boundary (27), (34) ----
   points_.assign(N_FE_, {});
+  point_signed_.assign(N_FE_, {});
   for (int n = 0; n < N_FE_; ++n) {
     std::vector<int> start = n == 0 ? in.lambda_start : lambda_end_[n - 1];
-    if (!start.empty()) points_[n].push_back(start);
-    for (int s = 0; s < n_s_; ++s) points_[n].push_back(range(lambda(n, s, 0), n_th));
-    if (boundary_vars_[n]) points_[n].push_back(lambda_end_[n]);
+    if (!start.empty()) {
+      points_[n].push_back(start);
+      point_signed_[n].push_back(true);
+    }
+    for (int s = 0; s < n_s_; ++s) {
+      points_[n].push_back(range(lambda(n, s, 0), n_th));
+      point_signed_[n].push_back(stage_signed_[idx(n, s)]);
+    }
+    if (boundary_vars_[n]) {
+      points_[n].push_back(lambda_end_[n]);
+      point_signed_[n].push_back(true);
+    }
   }
 
   step_eq_rows_.clear();
@@ -306,8 +334,10 @@ void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
         f.th_B.assign(n_th, {});
         f.th_F.assign(n_th, {});
         for (int r = 0; r < n_th; ++r) {
-          for (const auto& pt : points_[n - 1]) f.lam_B[r].push_back(vl.add(pt[r]));
-          for (const auto& pt : points_[n]) f.lam_F[r].push_back(vl.add(pt[r]));
+          for (std::size_t q = 0; q < points_[n - 1].size(); ++q)  // signed points only
+            if (point_signed_[n - 1][q]) f.lam_B[r].push_back(vl.add(points_[n - 1][q][r]));
+          for (std::size_t q = 0; q < points_[n].size(); ++q)
+            if (point_signed_[n][q]) f.lam_F[r].push_back(vl.add(points_[n][q][r]));
           for (int s = 0; s < n_s_; ++s) {
             f.th_B[r].push_back(vl.add(theta(n - 1, s, r)));
             f.th_F[r].push_back(vl.add(theta(n, s, r)));
@@ -345,6 +375,13 @@ void FesdInterval::build_complementarity() {
         for (int q = 0; q < static_cast<int>(pts.size()); ++q) {
           if (!fesd && q != own) continue;  // standard method: no cross complementarity
           const CompPair pair{theta(n, s, r), pts[q][r]};
+          if (!point_signed_[n][q]) {  // free lambda: only its own stage's product, two-sided
+            if (q == own) {
+              residual_pairs_.push_back(pair);
+              groups_.push_back({{pair}, /*two_sided=*/true});
+            }
+            continue;
+          }
           residual_pairs_.push_back(pair);
           stage_sum.pairs.push_back(pair);
           element.pairs.push_back(pair);
@@ -353,7 +390,8 @@ void FesdInterval::build_complementarity() {
               (opt_.cross_comp == CrossComp::Neighbor && q == own))
             groups_.push_back({{pair}});
         }
-        if (fesd && opt_.cross_comp == CrossComp::StageSum) groups_.push_back(std::move(stage_sum));
+        if (fesd && opt_.cross_comp == CrossComp::StageSum && !stage_sum.pairs.empty())
+          groups_.push_back(std::move(stage_sum));
       }
     }
     if (fesd && opt_.cross_comp == CrossComp::Element) groups_.push_back(std::move(element));
@@ -404,8 +442,10 @@ std::vector<double> FesdInterval::eta(const double* w) const {
     double e = 1.0;
     for (int r = 0; r < n_th; ++r) {
       double lb = 0, lf = 0, tb = 0, tf = 0;
-      for (const auto& pt : points_[n - 1]) lb += w[pt[r]];
-      for (const auto& pt : points_[n]) lf += w[pt[r]];
+      for (std::size_t q = 0; q < points_[n - 1].size(); ++q)
+        if (point_signed_[n - 1][q]) lb += w[points_[n - 1][q][r]];
+      for (std::size_t q = 0; q < points_[n].size(); ++q)
+        if (point_signed_[n][q]) lf += w[points_[n][q][r]];
       for (int s = 0; s < n_s_; ++s) {
         tb += w[theta(n - 1, s, r)];
         tf += w[theta(n, s, r)];

@@ -34,6 +34,9 @@ struct CompPair {
 /// a solution of the MPCC. The MPCC layer relaxes it (e.g. <= sigma).
 struct CompGroup {
   std::vector<CompPair> pairs;
+  /// b is a lambda without sign condition (StageLambdaSign::Boundary): the product must vanish
+  /// but has no sign, so the relaxation bounds it on both sides (|a * b| <= sigma).
+  bool two_sided = false;
 };
 
 /// Where the interval's inputs live in the NLP (variables, possibly fixed by their bounds).
@@ -47,6 +50,10 @@ struct IntervalInputs {
   /// For schemes that are not stiffly accurate: add boundary values (33) at the interval end too
   /// (needed when another interval follows).
   bool boundary_at_end = false;
+  /// lambda_start, mu_start are free variables (lambda >= 0) that the interval ties to s0 with
+  /// the LP equation (9): g(s0) - lambda_{0,0} - mu_{0,0} e = 0. Needed when s0 is a variable
+  /// (OCP with free x0), and more robust than fixed values when s0 lies on a switching surface.
+  bool lp_at_start = false;
 };
 
 class FesdInterval {
@@ -76,6 +83,11 @@ class FesdInterval {
   int mu_end(int n, int k) const { return mu_end_[n].empty() ? -1 : mu_end_[n][k]; }
   /// The lambda "points" of element n (Sect. 3.2.2): start (m' = 0), stages, end boundary.
   const std::vector<std::vector<int>>& lambda_points(int n) const { return points_[n]; }
+  /// Whether lambda >= 0 holds at point q of element n (false only for free stage lambdas,
+  /// StageLambdaSign::Boundary).
+  bool point_signed(int n, int q) const { return point_signed_[n][q]; }
+  /// Whether the stage lambdas of interior stages are free (StageLambdaSign resolved).
+  bool boundary_sign() const { return boundary_sign_; }
   /// Every (28) product, standard ones included: the complementarity residual is their max.
   const std::vector<CompPair>& residual_pairs() const { return residual_pairs_; }
   /// The complementarity constraints in the form chosen by cross_comp_mode.
@@ -100,6 +112,9 @@ class FesdInterval {
   std::vector<std::vector<int>> lambda_end_, mu_end_;
   std::vector<bool> boundary_vars_;  // element n has boundary LP variables (33) at t_{n+1}
   std::vector<std::vector<std::vector<int>>> points_;
+  std::vector<std::vector<bool>> point_signed_;
+  std::vector<bool> stage_signed_;  // per idx(n, m): lambda_{n,m} >= 0
+  bool boundary_sign_ = false;
   std::vector<CompPair> residual_pairs_;
   std::vector<CompGroup> groups_;
   std::vector<int> step_eq_rows_;

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <memory>
 #include <sstream>
 
@@ -22,6 +23,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 constexpr double kActiveThetaTol = 1e-6;
+constexpr int kMaxSplit = 2;  // a failed step is retried as halves, then quarters
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
@@ -46,10 +48,59 @@ std::vector<int> fixed_vars(nlp::BlockNlp& nlp, int n) {
   return v;
 }
 
+std::vector<int> range_of(int first, int n) {
+  std::vector<int> v;
+  for (int i = 0; i < n; ++i) v.push_back(first + i);
+  return v;
+}
+
+/// Fixes the variables to the values, or only uses them as the initial guess.
+void fix_or_guess(nlp::BlockNlp& nlp, const std::vector<int>& vars, const Eigen::VectorXd& values,
+                  bool guess_only) {
+  if (!guess_only) return fix(nlp, vars, values);
+  for (std::size_t i = 0; i < vars.size(); ++i)
+    nlp.x_init[vars[i]] = values[static_cast<Eigen::Index>(i)];
+}
+
 Eigen::VectorXd gather(const std::vector<double>& w, int first, int n) {
   Eigen::VectorXd v(n);
   for (int i = 0; i < n; ++i) v[i] = w[first + i];
   return v;
+}
+
+/// Appends the N_FE elements of a step (NLP point w) to the result; advances t.
+void append_step(IntegratorResult& res, const Pss& model, const discretization::FesdInterval& iv,
+                 const Tableau& tab, const std::vector<double>& w, double& t) {
+  const int n_x = model.n_x(), n_th = model.n_theta(), n_sys = model.n_sys();
+  for (int n = 0; n < iv.N_FE(); ++n) {
+    const double hn = w[iv.h(n)];
+    // Active regions of the element: theta_{n,m,r} > 1e-6 at some stage. theta is a convex
+    // weight in [0, 1]; inactive regions have theta ~ sigma / lambda at the solution, and
+    // lambda alone cannot decide (it vanishes for every region at a switching boundary).
+    std::vector<int> active;
+    for (int r = 0; r < n_th; ++r) {
+      double th = 0;
+      for (int s = 0; s < iv.n_s(); ++s) th = std::max(th, w[iv.theta(n, s, r)]);
+      if (th > kActiveThetaTol) active.push_back(r);
+    }
+    for (int s = 0; s < iv.n_s(); ++s) {
+      res.t_stage.push_back(t + tab.c(s) * hn);
+      res.x_stage.push_back(gather(w, iv.X(n, s, 0), n_x));
+      res.theta.push_back(gather(w, iv.theta(n, s, 0), n_th));
+      res.lambda.push_back(gather(w, iv.lambda(n, s, 0), n_th));
+      res.mu.push_back(gather(w, iv.mu(n, s, 0), n_sys));
+    }
+    if (!res.active_set.empty() && res.active_set.back() != active)
+      res.switches.push_back(
+          {t, static_cast<int>(res.h.size()) - 1, res.active_set.back(), active});
+    res.active_set.push_back(active);
+    res.h.push_back(hn);
+    t += hn;
+    Eigen::VectorXd xn(n_x);
+    for (int i = 0; i < n_x; ++i) xn[i] = w[iv.x(n + 1, i)];
+    res.t.push_back(t);
+    res.x.push_back(xn);
+  }
 }
 
 /// The NLP of one integration step: built once, re-solved for every step with new fixed inputs.
@@ -66,8 +117,19 @@ std::unique_ptr<StepNlp> build_step_nlp(const Pss& model, const Tableau& tab,
   s->in.s0 = fixed_vars(s->nlp, model.n_x());
   s->in.q = fixed_vars(s->nlp, model.n_u());
   s->in.p = fixed_vars(s->nlp, model.n_p());
-  s->in.lambda_start = fixed_vars(s->nlp, model.n_theta());
-  s->in.mu_start = fixed_vars(s->nlp, model.n_sys());
+  // FESD: lambda_{0,0}, mu_{0,0} are variables tied to s0 by the LP equation (9), not fixed
+  // numbers, so that a step starting on a switching surface (c(s0) = O(1e-13)) is not made
+  // infeasible by the round-off sign of a fixed lambda_{0,0}. The standard method does not use
+  // them (no cross complementarity): fixed.
+  const int n_th = model.n_theta(), n_sys = model.n_sys();
+  if (d.use_fesd) {
+    s->in.lambda_start = range_of(s->nlp.add_variables(n_th, 0.0, nlp::kInf, 0.0), n_th);
+    s->in.mu_start = range_of(s->nlp.add_variables(n_sys, -nlp::kInf, nlp::kInf, 0.0), n_sys);
+    s->in.lp_at_start = true;
+  } else {
+    s->in.lambda_start = fixed_vars(s->nlp, n_th);
+    s->in.mu_start = fixed_vars(s->nlp, n_sys);
+  }
   s->in.T = T_step;
   // Non-stiffly-accurate schemes: boundary values (33) at the step end too, so that a switch
   // cannot hide between the last stage and the end of the step.
@@ -115,129 +177,136 @@ IntegratorResult integrate(const Pss& model, const Eigen::VectorXd& x0_in, doubl
   const int N_FE = d.N_FE, n_s = d.n_s;
   const double T_step = T_sim / N_sim;
 
-  // ---- the NLP of one step ----
-  const std::unique_ptr<StepNlp> primary = build_step_nlp(model, tab, d, T_step);
-  nlp::BlockNlp& nlp = primary->nlp;
-  const discretization::IntervalInputs& in = primary->in;
-  const discretization::FesdInterval& iv = *primary->iv;
-  // Built on first need: the same step with the sparse cross complementarity (28), which the
-  // homotopy follows more reliably (docs/benchmarks.md). Same variable layout, other rows.
-  std::unique_ptr<StepNlp> fallback;
+  // ---- the NLPs of one step ----
+  // Level k solves a step of length T_step / 2^k: a step whose homotopy fails (also in the
+  // sparse form) is retried as two half steps, up to kMaxSplit times (docs/benchmarks.md). Each
+  // level's NLP is built on first need and re-solved with new fixed inputs.
+  struct Level {
+    std::unique_ptr<StepNlp> primary;
+    // The same step with the sparse cross complementarity (28), which the homotopy follows more
+    // reliably (docs/benchmarks.md). Same variable layout, other rows. Built on first need.
+    std::unique_ptr<StepNlp> fallback;
+  };
+  std::vector<Level> levels(kMaxSplit + 1);
   const bool can_fall_back = d.use_fesd && d.cross_comp != CrossComp::Sparse;
+  auto level_nlp = [&](int k) -> StepNlp& {
+    if (!levels[k].primary) {
+      levels[k].primary = build_step_nlp(model, tab, d, T_step / std::ldexp(1.0, k));
+      StepNlp& sn = *levels[k].primary;
+      fix(sn.nlp, sn.in.q, u);
+      fix(sn.nlp, sn.in.p, p);
+    }
+    return *levels[k].primary;
+  };
 
   auto xdot_at = [&](const Eigen::VectorXd& x, const Eigen::VectorXd& theta) {
     Eigen::VectorXd xd(n_x);
     dcs::eval_F_theta<double>(model, x.data(), u.data(), p.data(), theta.data(), xd.data());
     return xd;
   };
-  Eigen::VectorXd x = x0_in;
-  dcs::LpSolution lp = dcs::solve_lp(model, x, p);
-  fix(nlp, in.s0, x);
-  fix(nlp, in.q, u);
-  fix(nlp, in.p, p);
-  fix(nlp, in.lambda_start, lp.lambda);
-  fix(nlp, in.mu_start, lp.mu);
-  iv.set_guess(nlp, x, lp, xdot_at(x, lp.theta));
-  nlp.finalize();
+  // Initial guess of the next step: the LP at x0 first, then the last stage of the last step.
+  dcs::LpSolution guess = dcs::solve_lp(model, x0_in, p);
+  Eigen::VectorXd guess_xdot = xdot_at(x0_in, guess.theta);
 
   IntegratorResult res;
+  level_nlp(0).nlp.finalize();
   res.summary.setup_s = seconds_since(t_start);
   nlp::IpoptSolver solver(options.nlp);
+  auto account = [&](const mpcc::HomotopyResult& h) {
+    res.summary.homotopy_steps += static_cast<int>(h.rows.size());
+    res.summary.nlp_iterations += h.nlp_iterations;
+    res.summary.derivative_s += h.eval_s;
+    res.summary.solver_s += h.solver_s;
+  };
 
   res.t.push_back(0.0);
-  res.x.push_back(x);
+  res.x.push_back(x0_in);
   double t = 0.0;
-  res.status = Status::Success;
-  res.message = "";
-  for (int step = 0; step < N_sim; ++step) {
-    if (step > 0) {  // new start state; guess: continue the last stage of the previous step
-      lp = dcs::solve_lp(model, x, p);
-      fix(nlp, in.s0, x);
-      fix(nlp, in.lambda_start, lp.lambda);
-      fix(nlp, in.mu_start, lp.mu);
-      dcs::LpSolution last;
-      last.theta = gather(nlp.x_init, iv.theta(N_FE - 1, n_s - 1, 0), n_th);
-      last.lambda = gather(nlp.x_init, iv.lambda(N_FE - 1, n_s - 1, 0), n_th);
-      last.mu = gather(nlp.x_init, iv.mu(N_FE - 1, n_s - 1, 0), n_sys);
-      const Eigen::VectorXd xdot = gather(nlp.x_init, iv.V(N_FE - 1, n_s - 1, 0), n_x);
-      iv.set_guess(nlp, x, last, xdot);
-    }
+  Eigen::VectorXd x = x0_in;
+  mpcc::HomotopyResult last_hr;
+  std::vector<double> failed_w;  // last iterate of a failed step, reported with the failure
+  const discretization::FesdInterval* failed_iv = nullptr;
+
+  // Solves one step of level k from x; on success appends it to res and advances t, x, guess.
+  auto solve_step = [&](int k) -> bool {
+    StepNlp& sn = level_nlp(k);
+    nlp::BlockNlp& nlp = sn.nlp;
+    const discretization::FesdInterval& iv = *sn.iv;
+    const dcs::LpSolution lp = dcs::solve_lp(model, x, p);
+    fix(nlp, sn.in.s0, x);
+    fix_or_guess(nlp, sn.in.lambda_start, lp.lambda, d.use_fesd);
+    fix_or_guess(nlp, sn.in.mu_start, lp.mu, d.use_fesd);
+    iv.set_guess(nlp, x, guess, guess_xdot);
+    if (!nlp.finalized()) nlp.finalize();
     nlp::Iterate it;
     it.x = nlp.x_init;
-    mpcc::HomotopyResult hr = mpcc::solve_homotopy(nlp, primary->comp_rows, iv.residual_pairs(),
-                                                   solver, it, options.homotopy);
+    mpcc::HomotopyResult hr =
+        mpcc::solve_homotopy(nlp, sn.comp_rows, iv.residual_pairs(), solver, it, options.homotopy);
     std::vector<HomotopyRow> rows = hr.rows;
-    auto account = [&](const mpcc::HomotopyResult& h) {
-      res.summary.homotopy_steps += static_cast<int>(h.rows.size());
-      res.summary.nlp_iterations += h.nlp_iterations;
-      res.summary.derivative_s += h.eval_s;
-      res.summary.solver_s += h.solver_s;
-    };
     account(hr);
     if (hr.status != Status::Success && can_fall_back) {  // same start, sparse form (28)
-      if (!fallback) {
+      if (!levels[k].fallback) {
         DiscretizationOptions sparse = d;
         sparse.cross_comp = CrossComp::Sparse;
-        fallback = build_step_nlp(model, tab, sparse, T_step);
+        levels[k].fallback = build_step_nlp(model, tab, sparse, T_step / std::ldexp(1.0, k));
       }
-      fallback->nlp.x_lb = nlp.x_lb;  // same layout: fixed inputs and bounds carry over
-      fallback->nlp.x_ub = nlp.x_ub;
-      fallback->nlp.x_init = nlp.x_init;
-      if (!fallback->nlp.finalized()) fallback->nlp.finalize();
-      nlp::Iterate retry;
-      retry.x = nlp.x_init;
-      hr = mpcc::solve_homotopy(fallback->nlp, fallback->comp_rows, fallback->iv->residual_pairs(),
-                                solver, retry, options.homotopy);
+      StepNlp& fb = *levels[k].fallback;
+      fb.nlp.x_lb = nlp.x_lb;  // same layout: fixed inputs and bounds carry over
+      fb.nlp.x_ub = nlp.x_ub;
+      fb.nlp.x_init = nlp.x_init;
+      if (!fb.nlp.finalized()) fb.nlp.finalize();
+      it.x = nlp.x_init;
+      it.z_L.clear();
+      it.z_U.clear();
+      it.lambda.clear();
+      hr = mpcc::solve_homotopy(fb.nlp, fb.comp_rows, fb.iv->residual_pairs(), solver, it,
+                                options.homotopy);
       account(hr);
       rows.insert(rows.end(), hr.rows.begin(), hr.rows.end());
       ++res.summary.fallback_steps;
-      it = std::move(retry);
     }
-    nlp.x_init = it.x;  // the solution: read below and the base of the next guess
-    const std::vector<double>& w = it.x;
     res.homotopy.push_back(std::move(rows));
-    res.summary.max_comp_residual = std::max(res.summary.max_comp_residual, hr.comp_residual);
-
-    for (int n = 0; n < N_FE; ++n) {
-      const double hn = w[iv.h(n)];
-      // Active regions of the element: theta_{n,m,r} > 1e-6 at some stage. theta is a convex
-      // weight in [0, 1]; inactive regions have theta ~ sigma / lambda at the solution, and
-      // lambda alone cannot decide (it vanishes for every region at a switching boundary).
-      std::vector<int> active;
-      for (int r = 0; r < n_th; ++r) {
-        double th = 0;
-        for (int s = 0; s < n_s; ++s) th = std::max(th, w[iv.theta(n, s, r)]);
-        if (th > kActiveThetaTol) active.push_back(r);
-      }
-      for (int s = 0; s < n_s; ++s) {
-        res.t_stage.push_back(t + tab.c(s) * hn);
-        res.x_stage.push_back(gather(w, iv.X(n, s, 0), n_x));
-        res.theta.push_back(gather(w, iv.theta(n, s, 0), n_th));
-        res.lambda.push_back(gather(w, iv.lambda(n, s, 0), n_th));
-        res.mu.push_back(gather(w, iv.mu(n, s, 0), n_sys));
-      }
-      if (!res.active_set.empty() && res.active_set.back() != active)
-        res.switches.push_back(
-            {t, static_cast<int>(res.h.size()) - 1, res.active_set.back(), active});
-      res.active_set.push_back(active);
-      res.h.push_back(hn);
-      t += hn;
-      Eigen::VectorXd xn(n_x);
-      for (int i = 0; i < n_x; ++i) xn[i] = w[iv.x(n + 1, i)];
-      res.t.push_back(t);
-      res.x.push_back(xn);
+    last_hr = hr;
+    const std::vector<double>& w = it.x;
+    if (hr.status != Status::Success) {
+      failed_w = w;
+      failed_iv = &iv;
+      return false;
     }
+    res.summary.max_comp_residual = std::max(res.summary.max_comp_residual, hr.comp_residual);
+    append_step(res, model, iv, tab, w, t);
     x = res.x.back();
+    guess.theta = gather(w, iv.theta(N_FE - 1, n_s - 1, 0), n_th);
+    guess.lambda = gather(w, iv.lambda(N_FE - 1, n_s - 1, 0), n_th);
+    guess.mu = gather(w, iv.mu(N_FE - 1, n_s - 1, 0), n_sys);
+    guess_xdot = gather(w, iv.V(N_FE - 1, n_s - 1, 0), n_x);
+    return true;
+  };
+  // Advances over one step of level k, splitting it into halves where it fails.
+  std::function<bool(int)> advance = [&](int k) -> bool {
+    if (solve_step(k)) return true;
+    if (k == kMaxSplit || !d.use_fesd) return false;
+    ++res.summary.split_steps;
+    return advance(k + 1) && advance(k + 1);
+  };
+
+  res.status = Status::Success;
+  res.message = "";
+  for (int step = 0; step < N_sim; ++step) {
+    const bool ok = advance(0);
     if (options.progress)
       std::fprintf(stderr, "  step %4d/%d  t = %-10.6g  NLPs %2zu  iter %4d  comp %.1e  %s\n",
-                   step + 1, N_sim, t, hr.rows.size(), hr.nlp_iterations, hr.comp_residual,
-                   std::string(to_string(hr.status)).c_str());
-    if (hr.status != Status::Success) {
-      res.status = hr.status;
+                   step + 1, N_sim, t, last_hr.rows.size(), last_hr.nlp_iterations,
+                   last_hr.comp_residual, std::string(to_string(last_hr.status)).c_str());
+    if (!ok) {
+      // Report the failed step's last iterate too, so the user sees where it went wrong.
+      if (failed_iv) append_step(res, model, *failed_iv, tab, failed_w, t);
+      res.status = last_hr.status;
       res.message = fmt::format(
           "step {} of {} (t = {:.6g}): {} (last IPOPT status {}, "
           "complementarity residual {:.2e})",
-          step + 1, N_sim, t, describe(hr.status), hr.last_nlp_status, hr.comp_residual);
+          step + 1, N_sim, t, describe(last_hr.status), last_hr.last_nlp_status,
+          last_hr.comp_residual);
       break;
     }
   }
@@ -282,8 +351,10 @@ std::string IntegratorResult::full_report() const {
     os << fmt::format("    t_s = {:.12g}   active regions {} -> {}\n", s.t, set(s.before),
                       set(s.after));
   }
-  const double steps = homotopy.empty() ? 1.0 : static_cast<double>(homotopy.size());
-  os << fmt::format("  integration steps    {}  ({} finite elements)\n", homotopy.size(), h.size());
+  // homotopy has one entry per solve attempt; every split adds a failed attempt.
+  const std::size_t n_steps = homotopy.size() - static_cast<std::size_t>(summary.split_steps);
+  const double steps = n_steps == 0 ? 1.0 : static_cast<double>(n_steps);
+  os << fmt::format("  integration steps    {}  ({} finite elements)\n", n_steps, h.size());
   os << fmt::format("  NLPs solved          {}  ({:.1f} per step)\n", summary.homotopy_steps,
                     summary.homotopy_steps / steps);
   os << fmt::format("  IPOPT iterations     {}  ({:.1f} per step)\n", summary.nlp_iterations,
@@ -292,6 +363,9 @@ std::string IntegratorResult::full_report() const {
   if (summary.fallback_steps > 0)
     os << fmt::format("  retried steps        {}  (sparse cross complementarity (28))\n",
                       summary.fallback_steps);
+  if (summary.split_steps > 0)
+    os << fmt::format("  split steps          {}  (retried as two half steps)\n",
+                      summary.split_steps);
   os << fmt::format("  wall time            {:.3f} s  ({:.2f} ms per step)\n", summary.wall_s,
                     1e3 * summary.wall_s / steps);
   const double busy = summary.derivative_s + summary.solver_s;

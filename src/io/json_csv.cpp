@@ -50,7 +50,9 @@ json stats(const Summary& s) {
               {"derivative_s", number(s.derivative_s)},
               {"solver_s", number(s.solver_s)},
               {"setup_s", number(s.setup_s)},
-              {"max_comp_residual", number(s.max_comp_residual)}};
+              {"max_comp_residual", number(s.max_comp_residual)},
+              {"fallback_steps", s.fallback_steps},
+              {"split_steps", s.split_steps}};
 }
 
 json switches(const std::vector<SwitchEvent>& events) {

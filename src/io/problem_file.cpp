@@ -49,7 +49,7 @@ constexpr std::array<std::string_view, 13> kReservedNames{
 
 // ---- scalar options: one table for files and overrides ----------------------------------------
 
-enum class Kind { Int, Double, Bool, Scheme, CrossCompMode, StepEqMode };
+enum class Kind { Int, Double, Bool, Scheme, CrossCompMode, StepEqMode, StageSignMode };
 
 /// A value read from a file or a command line, already converted to the option's kind.
 struct OptionValue {
@@ -59,6 +59,7 @@ struct OptionValue {
   RkScheme scheme = RkScheme::RadauIIA;
   CrossComp cross = CrossComp::StageSum;
   StepEq step = StepEq::HeuristicMean;
+  StageLambdaSign stage_sign = StageLambdaSign::Auto;
 };
 
 struct OptionSpec {
@@ -72,7 +73,7 @@ using Sp = SimulationProblem;
 using Ov = OptionValue;
 
 // Every scalar option: table, file key, kind, and where it goes.
-constexpr std::array<OptionSpec, 19> kOptions{{
+constexpr std::array<OptionSpec, 20> kOptions{{
     {"simulation", "T_sim", Kind::Double, [](Sp& q, const Ov& v) { q.T_sim = v.d; }},
     {"simulation", "N_sim", Kind::Int, [](Sp& q, const Ov& v) { q.N_sim = v.i; }},
     {"discretization", "rk_scheme", Kind::Scheme,
@@ -87,6 +88,8 @@ constexpr std::array<OptionSpec, 19> kOptions{{
      [](Sp& q, const Ov& v) { q.options.discretization.cross_comp = v.cross; }},
     {"discretization", "step_equilibration", Kind::StepEqMode,
      [](Sp& q, const Ov& v) { q.options.discretization.step_eq = v.step; }},
+    {"discretization", "stage_lambda_sign", Kind::StageSignMode,
+     [](Sp& q, const Ov& v) { q.options.discretization.stage_lambda_sign = v.stage_sign; }},
     {"discretization", "gamma_h", Kind::Double,
      [](Sp& q, const Ov& v) { q.options.discretization.gamma_h = v.d; }},
     {"discretization", "rho_h", Kind::Double,
@@ -131,6 +134,8 @@ constexpr std::array<CrossComp, 4> kCrossComps{CrossComp::Sparse, CrossComp::Sta
                                                CrossComp::Element, CrossComp::Neighbor};
 constexpr std::array<StepEq, 4> kStepEqs{StepEq::None, StepEq::Eta, StepEq::EtaTanh,
                                          StepEq::HeuristicMean};
+constexpr std::array<StageLambdaSign, 3> kStageSigns{
+    StageLambdaSign::All, StageLambdaSign::Boundary, StageLambdaSign::Auto};
 
 /// Parses an enum option name; on failure returns "unknown name (expected one of ...)".
 std::optional<std::string> parse_enum(Kind kind, std::string_view name, OptionValue& v) {
@@ -147,6 +152,10 @@ std::optional<std::string> parse_enum(Kind kind, std::string_view name, OptionVa
     case Kind::StepEqMode:
       if (parse(name, v.step)) return std::nullopt;
       valid = name_list(kStepEqs);
+      break;
+    case Kind::StageSignMode:
+      if (parse(name, v.stage_sign)) return std::nullopt;
+      valid = name_list(kStageSigns);
       break;
     default:
       break;

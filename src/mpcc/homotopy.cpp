@@ -46,13 +46,17 @@ std::vector<int> add_scholtes_rows(nlp::BlockNlp& nlp, const std::vector<CompGro
       f.pairs.emplace_back(a, b);
     }
     f.k = static_cast<int>(vars.size());
-    rows.push_back(nlp.add_constraint(nlp::make_block(f), vars, -nlp::kInf, 1.0));
+    rows.push_back(
+        nlp.add_constraint(nlp::make_block(f), vars, g.two_sided ? -1.0 : -nlp::kInf, 1.0));
   }
   return rows;
 }
 
 void set_sigma(nlp::BlockNlp& nlp, const std::vector<int>& rows, double sigma) {
-  for (int r : rows) nlp.g_ub[r] = sigma;
+  for (int r : rows) {
+    nlp.g_ub[r] = sigma;
+    if (nlp.g_lb[r] > -nlp::kInf) nlp.g_lb[r] = -sigma;  // two-sided group
+  }
 }
 
 HomotopyResult solve_homotopy(nlp::BlockNlp& nlp, const std::vector<int>& comp_rows,
@@ -63,14 +67,15 @@ HomotopyResult solve_homotopy(nlp::BlockNlp& nlp, const std::vector<int>& comp_r
   bool last_ok = false, eval_failed = false;
   int max_steps = o.max_homotopy_steps;
   if (max_steps == 0)  // automatic: until sigma reaches sigma_N
-    max_steps = 1 + static_cast<int>(std::ceil(std::log(o.sigma_N / o.sigma_0) /
-                                                std::log(o.homotopy_update_slope) - 1e-9));
+    max_steps =
+        1 + static_cast<int>(std::ceil(
+                std::log(o.sigma_N / o.sigma_0) / std::log(o.homotopy_update_slope) - 1e-9));
   for (int k = 0; k < max_steps; ++k) {
     set_sigma(nlp, comp_rows, sigma);
     const nlp::NlpResult r = solver.solve(nlp, it, /*warm_start=*/k > 0);
     res.comp_residual = comp_residual(it.x.data(), residual_pairs);
-    res.rows.push_back({k, sigma, res.comp_residual, r.objective, r.inf_pr, r.iterations,
-                        r.status, r.total_s, r.linear_solver});
+    res.rows.push_back({k, sigma, res.comp_residual, r.objective, r.inf_pr, r.iterations, r.status,
+                        r.total_s, r.linear_solver});
     res.eval_s += r.eval_s;
     res.solver_s += r.total_s - r.eval_s;
     res.nlp_iterations += r.iterations;
