@@ -69,11 +69,27 @@ struct DiscretizationOptions {
   double rho_h = 1.0;    ///< `rho_h` > 0: weight of the heuristic_mean penalty
 };
 
+/// How the complementarity constraints of the MPCC are relaxed, smoothed or penalized in the
+/// homotopy (Sect. 5.2). sigma is the homotopy parameter of every method: sigma_0, then
+/// sigma_{k+1} = homotopy_update_slope * sigma_k down to sigma_N.
+enum class MpccMode {
+  ScholtesIneq,       ///< every complementarity constraint  w1' w2 <= sigma  (default)
+  ScholtesEq,         ///< w1' w2 = sigma
+  FischerBurmeister,  ///< smoothed C-function  a + b - sqrt(a^2 + b^2 + 2 sigma) = 0 per pair
+  L1Penalty,          ///< (1 / sigma) * sum of all w1' w2 added to the objective
+  ElasticIneq,        ///< w1' w2 <= s, s >= 0 one elastic variable, (1 / sigma) * s in the objective
+};
+/// Problem-file key `mpcc_mode`: "scholtes_ineq", "scholtes_eq", "fischer_burmeister",
+/// "ell_1_penalty", "elastic_ineq".
+std::string_view to_string(MpccMode v);
+bool parse(std::string_view name, MpccMode& out);
+
 /// The MPCC homotopy: a sequence of relaxed NLPs with theta_i lambda_i <= sigma (Scholtes),
 /// sigma_{k+1} = homotopy_update_slope * sigma_k, until the complementarity residual (the largest
 /// product of a complementarity pair, cross-complementarity pairs included) is <=
 /// complementarity_tol.
 struct HomotopyOptions {
+  MpccMode mpcc_mode = MpccMode::ScholtesIneq;  ///< `mpcc_mode`
   double sigma_0 = 1.0;                ///< `sigma_0` > 0: first relaxation
   double homotopy_update_slope = 0.1;  ///< `homotopy_update_slope` in (0, 1)
   double sigma_N = 1e-12;              ///< `sigma_N` > 0: smallest sigma used

@@ -45,6 +45,13 @@ constexpr std::array<std::pair<StageLambdaSign, std::string_view>, 3> kStageLamb
     {StageLambdaSign::Boundary, "boundary"},
     {StageLambdaSign::Auto, "auto"},
 }};
+constexpr std::array<std::pair<MpccMode, std::string_view>, 5> kMpccMode{{
+    {MpccMode::ScholtesIneq, "scholtes_ineq"},
+    {MpccMode::ScholtesEq, "scholtes_eq"},
+    {MpccMode::FischerBurmeister, "fischer_burmeister"},
+    {MpccMode::L1Penalty, "ell_1_penalty"},
+    {MpccMode::ElasticIneq, "elastic_ineq"},
+}};
 
 void require(std::vector<std::string>& out, bool ok, const std::string& what) {
   if (!ok) out.push_back(what);
@@ -67,6 +74,8 @@ std::string_view to_string(StepEq v) {
 bool parse(std::string_view name, StepEq& out) {
   return parse_from(kStepEq, name, out);
 }
+std::string_view to_string(MpccMode v) { return name_from(kMpccMode, v); }
+bool parse(std::string_view name, MpccMode& out) { return parse_from(kMpccMode, name, out); }
 std::string_view to_string(StageLambdaSign v) {
   return name_from(kStageLambdaSign, v);
 }
