@@ -75,7 +75,9 @@ struct DiscretizationOptions {
 enum class MpccMode {
   ScholtesIneq,       ///< every complementarity constraint  w1' w2 <= sigma  (default)
   ScholtesEq,         ///< w1' w2 = sigma
-  FischerBurmeister,  ///< smoothed C-function  a + b - sqrt(a^2 + b^2 + 2 sigma) = 0 per pair
+  /// smoothed C-function  a + B - sqrt(a^2 + B^2 + 2 sigma) = 0 per group with a common factor
+  /// a (B = the sum of its partners); needs cross_comp_mode sparse or stage_sum
+  FischerBurmeister,
   L1Penalty,          ///< (1 / sigma) * sum of all w1' w2 added to the objective
   ElasticIneq,        ///< w1' w2 <= s, s >= 0 one elastic variable, (1 / sigma) * s in the objective
 };

@@ -94,6 +94,8 @@ constexpr OverrideKey kOverrideKeys[] = {
      "where lambda >= 0 holds: all (stages), boundary (element ends) or auto"},
     {"gamma_h", "--gamma_h", "step size freedom in (0, 1]"},
     {"rho_h", "--rho_h", "weight of the heuristic_mean penalty"},
+    {"mpcc_mode", "--mpcc_mode",
+     "scholtes_ineq, scholtes_eq, fischer_burmeister, ell_1_penalty or elastic_ineq"},
     {"sigma_0", "--sigma_0", "first homotopy relaxation"},
     {"homotopy_update_slope", "--homotopy_update_slope", "sigma_{k+1} = slope * sigma_k"},
     {"sigma_N", "--sigma_N", "smallest sigma"},
@@ -287,9 +289,10 @@ void print_header(const fesd::SimulationProblem& problem) {
   }
   fmt::print("\n");
   fmt::print(
-      "  homotopy    sigma_0 = {:g}, slope = {:g}, sigma_N = {:g}, complementarity_tol = {:g}, "
-      "N_homotopy = {}\n",
-      h.sigma_0, h.homotopy_update_slope, h.sigma_N, h.complementarity_tol, h.max_homotopy_steps);
+      "  homotopy    mpcc_mode = {}, sigma_0 = {:g}, slope = {:g}, sigma_N = {:g}, "
+      "complementarity_tol = {:g}, N_homotopy = {}\n",
+      fesd::to_string(h.mpcc_mode), h.sigma_0, h.homotopy_update_slope, h.sigma_N,
+      h.complementarity_tol, h.max_homotopy_steps);
   fmt::print("  ipopt       tol = {:g}, acceptable_tol = {:g}, max_iter = {}, print_level = {}",
              nlp.tol, nlp.acceptable_tol, nlp.max_iter, nlp.print_level);
   for (const auto& [name, value] : nlp.extra) fmt::print(", {} = {}", name, value);

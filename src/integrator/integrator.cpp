@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -108,11 +109,12 @@ struct StepNlp {
   nlp::BlockNlp nlp;
   discretization::IntervalInputs in;
   std::unique_ptr<discretization::FesdInterval> iv;
-  std::vector<int> comp_rows;
+  std::optional<mpcc::Relaxation> relaxation;  // of iv->groups(), in the homotopy's mpcc_mode
 };
 
 std::unique_ptr<StepNlp> build_step_nlp(const Pss& model, const Tableau& tab,
-                                        const DiscretizationOptions& d, double T_step) {
+                                        const DiscretizationOptions& d, double T_step,
+                                        MpccMode mpcc_mode) {
   auto s = std::make_unique<StepNlp>();
   s->in.s0 = fixed_vars(s->nlp, model.n_x());
   s->in.q = fixed_vars(s->nlp, model.n_u());
@@ -136,7 +138,7 @@ std::unique_ptr<StepNlp> build_step_nlp(const Pss& model, const Tableau& tab,
   s->in.boundary_at_end = true;
   s->iv = std::make_unique<discretization::FesdInterval>(model, tab, d);
   s->iv->build(s->nlp, s->in);
-  s->comp_rows = mpcc::add_scholtes_rows(s->nlp, s->iv->groups());
+  s->relaxation.emplace(s->nlp, s->iv->groups(), mpcc_mode);
   return s;
 }
 
@@ -188,10 +190,16 @@ IntegratorResult integrate(const Pss& model, const Eigen::VectorXd& x0_in, doubl
     std::unique_ptr<StepNlp> fallback;
   };
   std::vector<Level> levels(kMaxSplit + 1);
-  const bool can_fall_back = d.use_fesd && d.cross_comp != CrossComp::Sparse;
+  // scholtes_eq and fischer_burmeister impose one equation per pair: with the sparse form (28)
+  // a theta gets more equations than it has freedom (IPOPT: Not_Enough_Degrees_Of_Freedom), so
+  // the sparse retry is useless for them.
+  const MpccMode mode = options.homotopy.mpcc_mode;
+  const bool can_fall_back = d.use_fesd && d.cross_comp != CrossComp::Sparse &&
+                             mode != MpccMode::ScholtesEq && mode != MpccMode::FischerBurmeister;
   auto level_nlp = [&](int k) -> StepNlp& {
     if (!levels[k].primary) {
-      levels[k].primary = build_step_nlp(model, tab, d, T_step / std::ldexp(1.0, k));
+      levels[k].primary =
+          build_step_nlp(model, tab, d, T_step / std::ldexp(1.0, k), options.homotopy.mpcc_mode);
       StepNlp& sn = *levels[k].primary;
       fix(sn.nlp, sn.in.q, u);
       fix(sn.nlp, sn.in.p, p);
@@ -240,15 +248,16 @@ IntegratorResult integrate(const Pss& model, const Eigen::VectorXd& x0_in, doubl
     if (!nlp.finalized()) nlp.finalize();
     nlp::Iterate it;
     it.x = nlp.x_init;
-    mpcc::HomotopyResult hr =
-        mpcc::solve_homotopy(nlp, sn.comp_rows, iv.residual_pairs(), solver, it, options.homotopy);
+    mpcc::HomotopyResult hr = mpcc::solve_homotopy(nlp, *sn.relaxation, iv.residual_pairs(), solver,
+                                                   it, options.homotopy);
     std::vector<HomotopyRow> rows = hr.rows;
     account(hr);
     if (hr.status != Status::Success && can_fall_back) {  // same start, sparse form (28)
       if (!levels[k].fallback) {
         DiscretizationOptions sparse = d;
         sparse.cross_comp = CrossComp::Sparse;
-        levels[k].fallback = build_step_nlp(model, tab, sparse, T_step / std::ldexp(1.0, k));
+        levels[k].fallback = build_step_nlp(model, tab, sparse, T_step / std::ldexp(1.0, k),
+                                            options.homotopy.mpcc_mode);
       }
       StepNlp& fb = *levels[k].fallback;
       fb.nlp.x_lb = nlp.x_lb;  // same layout: fixed inputs and bounds carry over
@@ -259,7 +268,7 @@ IntegratorResult integrate(const Pss& model, const Eigen::VectorXd& x0_in, doubl
       it.z_L.clear();
       it.z_U.clear();
       it.lambda.clear();
-      hr = mpcc::solve_homotopy(fb.nlp, fb.comp_rows, fb.iv->residual_pairs(), solver, it,
+      hr = mpcc::solve_homotopy(fb.nlp, *fb.relaxation, fb.iv->residual_pairs(), solver, it,
                                 options.homotopy);
       account(hr);
       rows.insert(rows.end(), hr.rows.begin(), hr.rows.end());

@@ -49,7 +49,7 @@ constexpr std::array<std::string_view, 13> kReservedNames{
 
 // ---- scalar options: one table for files and overrides ----------------------------------------
 
-enum class Kind { Int, Double, Bool, Scheme, CrossCompMode, StepEqMode, StageSignMode };
+enum class Kind { Int, Double, Bool, Scheme, CrossCompMode, StepEqMode, StageSignMode, Mpcc };
 
 /// A value read from a file or a command line, already converted to the option's kind.
 struct OptionValue {
@@ -60,6 +60,7 @@ struct OptionValue {
   CrossComp cross = CrossComp::StageSum;
   StepEq step = StepEq::HeuristicMean;
   StageLambdaSign stage_sign = StageLambdaSign::Auto;
+  MpccMode mpcc = MpccMode::ScholtesIneq;
 };
 
 struct OptionSpec {
@@ -73,7 +74,7 @@ using Sp = SimulationProblem;
 using Ov = OptionValue;
 
 // Every scalar option: table, file key, kind, and where it goes.
-constexpr std::array<OptionSpec, 20> kOptions{{
+constexpr std::array<OptionSpec, 21> kOptions{{
     {"simulation", "T_sim", Kind::Double, [](Sp& q, const Ov& v) { q.T_sim = v.d; }},
     {"simulation", "N_sim", Kind::Int, [](Sp& q, const Ov& v) { q.N_sim = v.i; }},
     {"discretization", "rk_scheme", Kind::Scheme,
@@ -94,6 +95,8 @@ constexpr std::array<OptionSpec, 20> kOptions{{
      [](Sp& q, const Ov& v) { q.options.discretization.gamma_h = v.d; }},
     {"discretization", "rho_h", Kind::Double,
      [](Sp& q, const Ov& v) { q.options.discretization.rho_h = v.d; }},
+    {"homotopy", "mpcc_mode", Kind::Mpcc,
+     [](Sp& q, const Ov& v) { q.options.homotopy.mpcc_mode = v.mpcc; }},
     {"homotopy", "sigma_0", Kind::Double,
      [](Sp& q, const Ov& v) { q.options.homotopy.sigma_0 = v.d; }},
     {"homotopy", "homotopy_update_slope", Kind::Double,
@@ -136,6 +139,9 @@ constexpr std::array<StepEq, 4> kStepEqs{StepEq::None, StepEq::Eta, StepEq::EtaT
                                          StepEq::HeuristicMean};
 constexpr std::array<StageLambdaSign, 3> kStageSigns{
     StageLambdaSign::All, StageLambdaSign::Boundary, StageLambdaSign::Auto};
+constexpr std::array<MpccMode, 5> kMpccModes{MpccMode::ScholtesIneq, MpccMode::ScholtesEq,
+                                             MpccMode::FischerBurmeister, MpccMode::L1Penalty,
+                                             MpccMode::ElasticIneq};
 
 /// Parses an enum option name; on failure returns "unknown name (expected one of ...)".
 std::optional<std::string> parse_enum(Kind kind, std::string_view name, OptionValue& v) {
@@ -156,6 +162,10 @@ std::optional<std::string> parse_enum(Kind kind, std::string_view name, OptionVa
     case Kind::StageSignMode:
       if (parse(name, v.stage_sign)) return std::nullopt;
       valid = name_list(kStageSigns);
+      break;
+    case Kind::Mpcc:
+      if (parse(name, v.mpcc)) return std::nullopt;
+      valid = name_list(kMpccModes);
       break;
     default:
       break;

@@ -4,23 +4,6 @@
 #include <cmath>
 
 namespace fesd::mpcc {
-namespace {
-
-/// sum_p w[a_p] * w[b_p] over local indices.
-struct ProductSum {
-  std::vector<std::pair<int, int>> pairs;
-  int k = 0;
-  int num_inputs() const { return k; }
-  int num_outputs() const { return 1; }
-  template <class T>
-  void operator()(const T* w, T* c) const {
-    T s(0.0);
-    for (const auto& [a, b] : pairs) s = s + w[a] * w[b];
-    c[0] = s;
-  }
-};
-
-}  // namespace
 
 double comp_residual(const double* x, const std::vector<CompPair>& pairs) {
   double r = 0.0;
@@ -28,40 +11,10 @@ double comp_residual(const double* x, const std::vector<CompPair>& pairs) {
   return r;
 }
 
-std::vector<int> add_scholtes_rows(nlp::BlockNlp& nlp, const std::vector<CompGroup>& groups) {
-  std::vector<int> rows;
-  rows.reserve(groups.size());
-  for (const CompGroup& g : groups) {
-    std::vector<int> vars;
-    ProductSum f;
-    auto local = [&](int global) {
-      auto it = std::find(vars.begin(), vars.end(), global);
-      if (it != vars.end()) return static_cast<int>(it - vars.begin());
-      vars.push_back(global);
-      return static_cast<int>(vars.size()) - 1;
-    };
-    for (const CompPair& p : g.pairs) {
-      const int a = local(p.a);
-      const int b = local(p.b);
-      f.pairs.emplace_back(a, b);
-    }
-    f.k = static_cast<int>(vars.size());
-    rows.push_back(
-        nlp.add_constraint(nlp::make_block(f), vars, g.two_sided ? -1.0 : -nlp::kInf, 1.0));
-  }
-  return rows;
-}
-
-void set_sigma(nlp::BlockNlp& nlp, const std::vector<int>& rows, double sigma) {
-  for (int r : rows) {
-    nlp.g_ub[r] = sigma;
-    if (nlp.g_lb[r] > -nlp::kInf) nlp.g_lb[r] = -sigma;  // two-sided group
-  }
-}
-
-HomotopyResult solve_homotopy(nlp::BlockNlp& nlp, const std::vector<int>& comp_rows,
+HomotopyResult solve_homotopy(nlp::BlockNlp& nlp, const Relaxation& relaxation,
                               const std::vector<CompPair>& residual_pairs, nlp::NlpSolver& solver,
-                              nlp::Iterate& it, const HomotopyOptions& o) {
+                              nlp::Iterate& it, const HomotopyOptions& o,
+                              const std::function<void(const HomotopyRow&)>& on_row) {
   HomotopyResult res;
   double sigma = o.sigma_0;
   bool last_ok = false, eval_failed = false;
@@ -71,11 +24,19 @@ HomotopyResult solve_homotopy(nlp::BlockNlp& nlp, const std::vector<int>& comp_r
         1 + static_cast<int>(std::ceil(
                 std::log(o.sigma_N / o.sigma_0) / std::log(o.homotopy_update_slope) - 1e-9));
   for (int k = 0; k < max_steps; ++k) {
-    set_sigma(nlp, comp_rows, sigma);
+    relaxation.set_sigma(nlp, sigma);
+    // The start point carries the last sigma in the fixed sigma variable. IPOPT takes a fixed
+    // variable's value from its bounds anyway; set it so the point itself is consistent (for
+    // other NlpSolver backends, and in the solution returned in `it`).
+    if (const int v = relaxation.sigma_variable(); v >= 0 && v < static_cast<int>(it.x.size()))
+      it.x[v] = sigma;
     const nlp::NlpResult r = solver.solve(nlp, it, /*warm_start=*/k > 0);
     res.comp_residual = comp_residual(it.x.data(), residual_pairs);
+    // r.objective is the NLP's objective: for ell_1_penalty and elastic_ineq it includes the
+    // penalty term (1 / sigma) * (sum of groups, or s).
     res.rows.push_back({k, sigma, res.comp_residual, r.objective, r.inf_pr, r.iterations, r.status,
                         r.total_s, r.linear_solver});
+    if (on_row) on_row(res.rows.back());
     res.eval_s += r.eval_s;
     res.solver_s += r.total_s - r.eval_s;
     res.nlp_iterations += r.iterations;

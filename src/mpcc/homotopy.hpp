@@ -1,31 +1,29 @@
 // src/mpcc/homotopy.hpp: the MPCC of a discretization and its solution by a homotopy of relaxed
-// NLPs (Sect. 5.2). Scholtes relaxation: every complementarity constraint (a sum of products of
-// nonnegative variables) is imposed as  group(w) <= sigma,  sigma -> 0.
+// NLPs (Sect. 5.2): a sequence of smooth NLPs in which the complementarity constraints are
+// relaxed, smoothed or penalized by a Relaxation (relaxation.hpp) with parameter sigma,
+// sigma_0, then sigma_{k+1} = homotopy_update_slope * sigma_k down to sigma_N, each NLP
+// warm-started from the last.
 //
 // Complementarity residual (what "complementarity_tol" is compared with): the largest single
 // product theta_{n,m,i} * lambda_{n,m',i} over all pairs of (28), standard pairs included, i.e.
-// max over residual_pairs of |a * b|. It does not depend on cross_comp_mode.
+// max over residual_pairs of |a * b|. It depends neither on cross_comp_mode nor on mpcc_mode.
 #pragma once
+#include <functional>
+#include <string>
 #include <vector>
 
 #include "discretization/fesd_interval.hpp"
 #include "fesd/integrator.hpp"
 #include "fesd/options.hpp"
 #include "fesd/status.hpp"
+#include "mpcc/relaxation.hpp"
 #include "nlp/block_nlp.hpp"
 #include "nlp/nlp_solver.hpp"
 
 namespace fesd::mpcc {
 
-using discretization::CompGroup;
-using discretization::CompPair;
-
 /// max |a * b| over the pairs.
 double comp_residual(const double* x, const std::vector<CompPair>& pairs);
-
-/// Adds one row per group (Scholtes: -inf <= sum of products <= sigma); returns the rows.
-std::vector<int> add_scholtes_rows(nlp::BlockNlp& nlp, const std::vector<CompGroup>& groups);
-void set_sigma(nlp::BlockNlp& nlp, const std::vector<int>& rows, double sigma);
 
 struct HomotopyResult {
   Status status = Status::NotRun;
@@ -36,10 +34,13 @@ struct HomotopyResult {
   std::string last_nlp_status;
 };
 
-/// Solves the sequence of relaxed NLPs, warm-starting each from the last. `it` holds the start
-/// point on entry (primal only, or with duals) and the last solution on return.
-HomotopyResult solve_homotopy(nlp::BlockNlp& nlp, const std::vector<int>& comp_rows,
+/// Solves the sequence of relaxed NLPs, warm-starting each from the last, until an NLP converges
+/// with a complementarity residual <= complementarity_tol (Success), or sigma reaches sigma_N /
+/// the step limit is hit. `it` holds the start point on entry (primal only, or with duals) and
+/// the last solution on return. `on_row` (if set) is called after each NLP with its row.
+HomotopyResult solve_homotopy(nlp::BlockNlp& nlp, const Relaxation& relaxation,
                               const std::vector<CompPair>& residual_pairs, nlp::NlpSolver& solver,
-                              nlp::Iterate& it, const HomotopyOptions& options);
+                              nlp::Iterate& it, const HomotopyOptions& options,
+                              const std::function<void(const HomotopyRow&)>& on_row = {});
 
 }  // namespace fesd::mpcc

@@ -1,0 +1,203 @@
+// include/fesd/ocp.hpp: direct optimal control of piecewise smooth systems with FESD, Sect. 5 of
+// papers/fesd-filippov.txt.
+//
+//   min  int_0^T f_q(x, u, p) dt + f_q_T(x(T), p)                                          (58a)
+//   s.t. x(0) = x0 (or x0 free within bounds),  Filippov dynamics of the Pss (58c-f),
+//        lbg_path <= g_path(x, u, p) <= ubg_path,  lbx <= x <= ubx,  lbu <= u <= ubu,       (58g)
+//        lbg_terminal <= g_terminal(x(T), p) <= ubg_terminal                                (58h)
+//
+// discretized as (59): N_stages control intervals of equal length T / N_stages with a constant
+// control each, and on every interval one FESD discretization (32) with N_FE finite elements
+// (src/discretization/fesd_interval.hpp). The Lagrange term is integrated with the RK scheme's own
+// quadrature, sum_n h_n sum_j b_j f_q(X_{n,j}, q_k, p). The resulting MPCC is solved by a homotopy
+// (HomotopyOptions::mpcc_mode).
+//
+// User functions are templates on the scalar type, as for models (model.hpp); all are optional:
+//
+//   template <class T> T f_q(const T* x, const T* u, const T* p) const;             // Lagrange
+//   term template <class T> T f_q_T(const T* x, const T* p) const;                       // Mayer
+//   term template <class T> void g_path(const T* x, const T* u, const T* p, T* out) const; template
+//   <class T> void g_terminal(const T* x, const T* p, T* out) const;
+//
+// Example (the sensitivity OCP (56): min int_0^2 x^2 dt + (x(2) - 5/3)^2 over x0):
+//
+//   struct Cost {
+//     template <class T> T f_q(const T* x, const T*, const T*) const { return x[0] * x[0]; }
+//     template <class T> T f_q_T(const T* x, const T*) const { return (x[0] - 5.0 / 3) * (x[0]
+//     - 5.0 / 3); }
+//   };
+//   fesd::Ocp ocp;
+//   ocp.model = ...;  ocp.functions = fesd::make_ocp_functions(Cost{});
+//   ocp.T = 2;  ocp.x0 = Eigen::VectorXd::Constant(1, -1.0);  ocp.lbx0 = ...;  ocp.ubx0 = ...;
+//   fesd::OcpResult r = fesd::solve(ocp, options);
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "fesd/ad.hpp"
+#include "fesd/integrator.hpp"
+#include "fesd/model.hpp"
+#include "fesd/options.hpp"
+#include "fesd/status.hpp"
+
+namespace fesd {
+
+/// Type-erased OCP functions, one virtual per scalar type (made by make_ocp_functions and by
+/// problem files). `has_*` say which ones the user gave.
+class OcpFunctions {
+ public:
+  virtual ~OcpFunctions() = default;
+  virtual bool has_f_q() const = 0;
+  virtual bool has_f_q_T() const = 0;
+#define FESD_DECLARE_OCP_FUNCTIONS(T)                                        \
+  virtual T f_q(const T* x, const T* u, const T* p) const = 0;               \
+  virtual T f_q_T(const T* x, const T* p) const = 0;                         \
+  virtual void g_path(const T* x, const T* u, const T* p, T* out) const = 0; \
+  virtual void g_terminal(const T* x, const T* p, T* out) const = 0;
+  FESD_FOR_EACH_SCALAR(FESD_DECLARE_OCP_FUNCTIONS)
+#undef FESD_DECLARE_OCP_FUNCTIONS
+};
+
+/// How the terminal constraints are imposed (nosnoc: relax_terminal_constraint).
+enum class TerminalConstraint {
+  Hard,  ///< lbg_terminal <= g_terminal <= ubg_terminal exactly
+  /// l1 penalty: rho_terminal * sum_i s_i in the objective, with slacks s >= 0,
+  /// g_i - ubg_i <= s_i and lbg_i - g_i <= s_i (the paper's rho ||q(T) - q_final||_1 of (61)).
+  L1,
+};
+
+/// An optimal control problem. Vectors left empty mean "none" (bounds) or "zero" (guesses).
+struct Ocp {
+  Pss model;
+  std::shared_ptr<const OcpFunctions> functions;  ///< costs and constraints; may be null
+  double T = 0;                                   ///< horizon (nosnoc: T), > 0
+  int N_stages = 1;  ///< control intervals of equal length (nosnoc: N_stages)
+  /// Finite elements per control interval; empty: options.discretization.N_FE for every interval.
+  std::vector<int> N_FE;
+
+  Eigen::VectorXd x0;          ///< initial state; the initial guess of x0 if it is free
+  Eigen::VectorXd lbx0, ubx0;  ///< if given, x0 is a decision variable within these bounds
+  Eigen::VectorXd lbx, ubx;    ///< state bounds at every element boundary (and stage point)
+  Eigen::VectorXd lbu, ubu;    ///< control bounds
+  Eigen::VectorXd u_guess;     ///< initial guess of every control
+  Eigen::VectorXd p;           ///< parameter values; empty: model.p_default
+
+  int n_g_path = 0;  ///< number of path constraints g_path(x, u, p)
+  Eigen::VectorXd lbg_path, ubg_path;
+  int n_g_terminal = 0;  ///< number of terminal constraints g_terminal(x(T), p)
+  Eigen::VectorXd lbg_terminal, ubg_terminal;
+  TerminalConstraint terminal_constraint = TerminalConstraint::Hard;
+  double rho_terminal = 1e3;  ///< weight of the l1 terminal penalty, > 0
+};
+
+/// Initial guess of the states (nosnoc: initialization).
+enum class OcpInitialization {
+  Constant,    ///< x0 at every point, algebraic variables from LP(x0) (the paper's Sect. 5.2)
+  Simulation,  ///< a forward simulation from x0 with u_guess on the same grid (Sect. 4.5)
+};
+
+struct OcpOptions {
+  DiscretizationOptions discretization;
+  HomotopyOptions homotopy;
+  NlpOptions nlp;
+  OcpInitialization initialization = OcpInitialization::Constant;
+  /// Evaluate path constraints and state bounds at the RK stage points too, not only at the
+  /// element boundaries.
+  bool constraints_at_stages = false;
+  /// Print one line per homotopy step (sigma, residual, objective, inf_pr, iterations, status,
+  /// time) to stderr.
+  bool progress = false;
+};
+
+/// Empty if valid, else one line per broken rule.
+std::vector<std::string> validate(const OcpOptions& o);
+
+/// The solution of an OCP. Grid = all finite-element boundaries of all control intervals.
+struct OcpResult {
+  Status status = Status::NotRun;
+  std::string message;
+  double objective = 0;      ///< the OCP's own cost (59a): no penalty terms of the MPCC method
+  double comp_residual = 0;  ///< final complementarity residual (largest product of a pair)
+  MpccMode mpcc_mode = MpccMode::ScholtesIneq;
+
+  std::vector<double> t;                     ///< element boundaries, t.front() = 0, t.back() = T
+  std::vector<Eigen::VectorXd> x;            ///< states at t
+  std::vector<double> h;                     ///< h_{k,n} of every element, interval by interval
+  std::vector<int> interval;                 ///< control interval k of every element
+  std::vector<double> t_ctrl;                ///< control grid, N_stages + 1 points
+  std::vector<Eigen::VectorXd> u;            ///< control of each interval
+  std::vector<std::vector<int>> active_set;  ///< active regions per element
+  std::vector<SwitchEvent> switches;         ///< element boundaries where the active set changes
+  /// eta of (31) at every interior element boundary of an interval (NaN at interval starts):
+  /// zero where a switch happens. One entry per element.
+  std::vector<double> eta;
+  std::vector<double> t_stage;           ///< stage times
+  std::vector<Eigen::VectorXd> x_stage;  ///< stage states
+  std::vector<Eigen::VectorXd> theta, lambda;
+
+  std::vector<HomotopyRow> homotopy;  ///< one row per NLP
+  int nlp_iterations = 0;
+  int n_variables = 0, n_constraints = 0;
+  double wall_s = 0, derivative_s = 0, solver_s = 0, setup_s = 0;
+
+  Eigen::VectorXd x0() const { return x.empty() ? Eigen::VectorXd() : x.front(); }
+  Eigen::VectorXd x_final() const { return x.empty() ? Eigen::VectorXd() : x.back(); }
+  /// A multi-line human summary (status, objective, switches, homotopy table, timing).
+  std::string report() const;
+};
+
+/// Solves the OCP. Throws fesd::InvalidModel / InvalidOption for bad input (dimensions, NaN,
+/// options out of range); a solver failure is a status in the result.
+OcpResult solve(const Ocp& ocp, const OcpOptions& options);
+
+namespace detail {
+template <class F>
+class OcpFunctionsFor final : public OcpFunctions {
+ public:
+  explicit OcpFunctionsFor(F f) : f_(std::move(f)) {}
+  bool has_f_q() const override {
+    return requires(const double* v) {
+      f_.f_q(v, v, v);
+    };
+  }
+  bool has_f_q_T() const override {
+    return requires(const double* v) {
+      f_.f_q_T(v, v);
+    };
+  }
+#define FESD_IMPLEMENT_OCP_FUNCTIONS(T)                                             \
+  T f_q(const T* x, const T* u, const T* p) const override {                        \
+    if constexpr (requires { f_.f_q(x, u, p); })                                    \
+      return f_.f_q(x, u, p);                                                       \
+    else                                                                            \
+      return T(0.0);                                                                \
+  }                                                                                 \
+  T f_q_T(const T* x, const T* p) const override {                                  \
+    if constexpr (requires { f_.f_q_T(x, p); })                                     \
+      return f_.f_q_T(x, p);                                                        \
+    else                                                                            \
+      return T(0.0);                                                                \
+  }                                                                                 \
+  void g_path(const T* x, const T* u, const T* p, T* out) const override {          \
+    if constexpr (requires { f_.g_path(x, u, p, out); }) f_.g_path(x, u, p, out);   \
+  }                                                                                 \
+  void g_terminal(const T* x, const T* p, T* out) const override {                  \
+    if constexpr (requires { f_.g_terminal(x, p, out); }) f_.g_terminal(x, p, out); \
+  }
+  FESD_FOR_EACH_SCALAR(FESD_IMPLEMENT_OCP_FUNCTIONS)
+#undef FESD_IMPLEMENT_OCP_FUNCTIONS
+ private:
+  F f_;
+};
+}  // namespace detail
+
+/// Wraps C++ cost/constraint functions (see the top of this file) into OcpFunctions.
+template <class F>
+std::shared_ptr<const OcpFunctions> make_ocp_functions(F f) {
+  return std::make_shared<detail::OcpFunctionsFor<F>>(std::move(f));
+}
+
+}  // namespace fesd

@@ -1,0 +1,82 @@
+// src/mpcc/relaxation.hpp: how the complementarity constraints (60c) of the MPCC (60) (Sect. 5.2)
+// enter the relaxed NLPs of the homotopy. sigma > 0 is the homotopy parameter of every method; each
+// NLP of the sequence is a smooth NLP, and sigma -> 0 recovers the MPCC.
+//
+// A complementarity constraint is a CompGroup: G(w) = sum_p a_p b_p with a_p, b_p >= 0 by their
+// variable bounds, so G >= 0 and the MPCC asks G = 0. Per MpccMode:
+//
+//   scholtes_ineq       G <= sigma                                  (one row per group)
+//   scholtes_eq         G  = sigma                                  (one row per group)
+//   fischer_burmeister  phi(a, B) = a + B - sqrt(a^2 + B^2 + 2 sigma) = 0 with B = sum_p b_p when
+//                       every pair shares its a (or the roles swapped when every pair shares b).
+//                       phi = 0 <=> a, B > 0 and a B = sigma, i.e. the smoothed Fischer-Burmeister
+//                       C-function of Sect. 1 imposes G = sigma by a function that is smooth
+//                       everywhere for sigma > 0, a = B = 0 included. Groups without a common
+//                       factor (cross_comp_mode element, neighbor) are rejected: they are not one
+//                       complementarity pair.
+//   ell_1_penalty       objective += (1 / sigma) * sum of all G      (no rows)
+//   elastic_ineq        G <= s for every group with one variable s >= 0, objective += s / sigma
+//
+// ell_1_penalty and elastic_ineq are exact penalties: once 1 / sigma exceeds the multipliers of
+// the complementarity constraints, their NLP solution is complementary (up to IPOPT's tolerance),
+// often from the first sigma on. scholtes_eq and fischer_burmeister are equations: with
+// cross_comp_mode sparse every theta_{n,m,i} of FESD gets one equation per lambda point of its
+// element, more equations than unknowns (Example 3(a), Radau IIA, n_s = 1 or 2, N_FE = 2: IPOPT
+// stops with Not_Enough_Degrees_Of_Freedom), so they need stage_sum; and they ask a * B = sigma > 0
+// also of pairs that vanish together at the solution (both theta and lambda -> 0, e.g. where a
+// sliding mode ends), where the relaxed NLPs are degenerate.
+//
+// Two-sided groups (CompGroup::two_sided: b is a lambda without sign condition, so a_p b_p has no
+// sign) stay Scholtes rows -sigma <= G <= sigma in every mode: a product of free sign can neither
+// be penalized (it would be driven to -inf), nor smoothed by a C-function (which needs b >= 0),
+// nor be set = sigma (its sign is not known in advance).
+#pragma once
+#include <vector>
+
+#include "discretization/fesd_interval.hpp"
+#include "fesd/options.hpp"
+#include "nlp/block_nlp.hpp"
+
+namespace fesd::mpcc {
+
+using discretization::CompGroup;
+using discretization::CompPair;
+
+/// The relaxation of the complementarity groups of one NLP in one MpccMode.
+class Relaxation {
+ public:
+  /// Adds rows / variables / objective terms for `groups` to `nlp` (before nlp.finalize()).
+  /// Throws fesd::InvalidOption naming the problem when the mode cannot express a group
+  /// (fischer_burmeister on a group without a common factor).
+  Relaxation(nlp::BlockNlp& nlp, const std::vector<CompGroup>& groups, MpccMode mode);
+
+  /// Sets sigma: row bounds, the fixed sigma variable (fischer_burmeister), objective weights
+  /// 1 / sigma (ell_1_penalty, elastic_ineq).
+  void set_sigma(nlp::BlockNlp& nlp, double sigma) const;
+
+  MpccMode mode() const { return mode_; }
+  /// Per group: its constraint row, or -1 (ell_1_penalty groups, which are objective terms, and
+  /// empty groups outside scholtes_ineq, which are identically zero).
+  const std::vector<int>& group_rows() const { return group_rows_; }
+  /// The NLP variable fixed to sigma by its bounds (fischer_burmeister), else -1.
+  int sigma_variable() const { return sigma_var_; }
+  /// The elastic variable s (elastic_ineq), else -1.
+  int elastic_variable() const { return elastic_var_; }
+
+ private:
+  MpccMode mode_;
+  std::vector<int> group_rows_;
+  std::vector<int> upper_rows_;      // -inf <= G <= sigma
+  std::vector<int> two_sided_rows_;  // -sigma <= G <= sigma
+  std::vector<int> equal_rows_;      // G = sigma
+  std::vector<int> objectives_;      // objective terms with weight 1 / sigma
+  int sigma_var_ = -1, elastic_var_ = -1;
+};
+
+/// Adds one row per group (Scholtes: -inf <= sum of products <= sigma; -sigma <= sum <= sigma for
+/// two-sided groups); returns the rows. The scholtes_ineq mode of Relaxation.
+std::vector<int> add_scholtes_rows(nlp::BlockNlp& nlp, const std::vector<CompGroup>& groups);
+/// Sets sigma in rows made by add_scholtes_rows.
+void set_sigma(nlp::BlockNlp& nlp, const std::vector<int>& rows, double sigma);
+
+}  // namespace fesd::mpcc

@@ -1,0 +1,277 @@
+// tests/mpcc/relaxation_test.cpp: the MPCC solution methods (MpccMode, src/mpcc/relaxation.hpp)
+// on a two-variable MPCC with a known solution, through the integrator on Example 3(a), and the
+// rules every mode keeps: two-sided groups stay Scholtes rows, Fischer-Burmeister needs groups
+// with a common factor.
+#include <cmath>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "discretization/fesd_interval.hpp"
+#include "fesd/error.hpp"
+#include "fesd/integrator.hpp"
+#include "fesd/model.hpp"
+#include "fesd/problem_file.hpp"
+#include "mpcc/homotopy.hpp"
+#include "nlp/block.hpp"
+#include "nlp/ipopt_solver.hpp"
+
+namespace {
+
+using fesd::MpccMode;
+
+constexpr MpccMode kAllModes[] = {MpccMode::ScholtesIneq, MpccMode::ScholtesEq,
+                                  MpccMode::FischerBurmeister, MpccMode::L1Penalty,
+                                  MpccMode::ElasticIneq};
+
+std::string mode_name(const ::testing::TestParamInfo<MpccMode>& p) {
+  return std::string(fesd::to_string(p.param));
+}
+
+// ---- a two-variable MPCC ---------------------------------------------------------------------
+
+/// (x - 1)^2 + (y - 1)^2
+struct DistanceToOnes {
+  int num_inputs() const { return 2; }
+  int num_outputs() const { return 1; }
+  template <class T>
+  void operator()(const T* w, T* c) const {
+    c[0] = (w[0] - 1.0) * (w[0] - 1.0) + (w[1] - 1.0) * (w[1] - 1.0);
+  }
+};
+
+// min (x - 1)^2 + (y - 1)^2  s.t.  0 <= x _|_ y >= 0, from (0.9, 0.2). The MPCC has two
+// minimizers, (1, 0) and (0, 1), both with objective 1; the start lies on the side of (1, 0).
+class TinyMpcc : public ::testing::TestWithParam<MpccMode> {};
+TEST_P(TinyMpcc, ReachesTheLocalMinimizerOfTheStart) {
+  fesd::nlp::BlockNlp nlp;
+  const int x = nlp.add_variables(1, 0.0, fesd::nlp::kInf, 0.9);
+  const int y = nlp.add_variables(1, 0.0, fesd::nlp::kInf, 0.2);
+  nlp.add_objective(fesd::nlp::make_block(DistanceToOnes{}), {x, y});
+  const std::vector<fesd::mpcc::CompPair> pairs{{x, y}};
+  const std::vector<fesd::mpcc::CompGroup> groups{fesd::mpcc::CompGroup{pairs}};
+  const fesd::mpcc::Relaxation relaxation(nlp, groups, GetParam());
+  EXPECT_EQ(relaxation.mode(), GetParam());
+  nlp.finalize();
+
+  fesd::nlp::IpoptSolver solver(fesd::NlpOptions{});
+  fesd::nlp::Iterate it;
+  it.x = nlp.x_init;
+  int rows_seen = 0;
+  // Not sigma_0 = 1: the first relaxed NLP would then have its solution on the problem's axis of
+  // symmetry x = y ((1, 1) for the Scholtes and Fischer-Burmeister relaxations, (2/3, 2/3) for
+  // the penalties) and lose the start; the homotopy then follows x = y = sqrt(sigma) and round-off
+  // decides between (1, 0) and (0, 1). From sigma_0 = 0.1 every mode keeps the start's side.
+  fesd::HomotopyOptions options;
+  options.sigma_0 = 0.1;
+  const auto res = fesd::mpcc::solve_homotopy(nlp, relaxation, pairs, solver, it, options,
+                                              [&](const fesd::HomotopyRow& r) {
+                                                EXPECT_EQ(r.k, rows_seen);
+                                                ++rows_seen;
+                                              });
+  ASSERT_EQ(res.status, fesd::Status::Success) << res.last_nlp_status;
+  EXPECT_EQ(rows_seen, static_cast<int>(res.rows.size()));
+  EXPECT_LE(res.comp_residual, options.complementarity_tol);
+  EXPECT_NEAR(it.x[x], 1.0, 1e-6);
+  EXPECT_NEAR(it.x[y], 0.0, 1e-6);
+  const double f = (it.x[x] - 1) * (it.x[x] - 1) + (it.x[y] - 1) * (it.x[y] - 1);
+  EXPECT_NEAR(f, 1.0, 1e-6);
+}
+INSTANTIATE_TEST_SUITE_P(Modes, TinyMpcc, ::testing::ValuesIn(kAllModes), mode_name);
+
+// ---- Example 3(a) through the integrator ------------------------------------------------------
+
+// x' in 2 - sign(x): c = x, region 0 (x > 0) gives 1, region 1 (x < 0) gives 3.
+struct Crossing {
+  template <class T>
+  void c(const T* x, const T*, T* c) const {
+    c[0] = x[0];
+  }
+  template <class T>
+  void f(int region, const T*, const T*, const T*, T* f) const {
+    f[0] = T(region == 0 ? 1.0 : 3.0);
+  }
+};
+
+fesd::Pss crossing_model() {
+  return fesd::make_pss(Crossing{},
+                        fesd::PssDims{.n_x = 1, .subsystems = {fesd::Subsystem::from_c(1)}});
+}
+
+// x(0) = -1: switch at t_s = 1/3, x(T) = T - 1/3. With stage_sum every mode reaches
+// complementarity_tol = 1e-9 on every step.
+class CrossingEveryMode : public ::testing::TestWithParam<MpccMode> {};
+TEST_P(CrossingEveryMode, SwitchAtOneThird) {
+  fesd::IntegratorOptions o;
+  o.discretization.cross_comp = fesd::CrossComp::StageSum;
+  o.homotopy.mpcc_mode = GetParam();
+  Eigen::VectorXd x0(1);
+  x0 << -1.0;
+  const double T = 1.9;
+  const auto r = fesd::integrate(crossing_model(), x0, T, 7, o);
+  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+  ASSERT_EQ(r.switches.size(), 1U);
+  EXPECT_NEAR(r.switches[0].t, 1.0 / 3.0, 1e-6);
+  EXPECT_NEAR(r.x_final()[0], T - 1.0 / 3.0, 1e-6);
+  EXPECT_LE(r.summary.max_comp_residual, 1e-9);
+}
+INSTANTIATE_TEST_SUITE_P(Modes, CrossingEveryMode, ::testing::ValuesIn(kAllModes), mode_name);
+
+// ---- the interval's groups, built without solving --------------------------------------------
+
+struct Built {
+  fesd::nlp::BlockNlp nlp;
+  std::unique_ptr<fesd::discretization::FesdInterval> iv;
+};
+
+std::unique_ptr<Built> build(fesd::RkScheme scheme, int n_s, fesd::StageLambdaSign sign,
+                             fesd::CrossComp cross) {
+  static const fesd::Pss model = crossing_model();
+  fesd::DiscretizationOptions d;
+  d.rk_scheme = scheme;
+  d.n_s = n_s;
+  d.N_FE = 3;
+  d.stage_lambda_sign = sign;
+  d.cross_comp = cross;
+  auto b = std::make_unique<Built>();
+  auto fixed = [&](int n) {
+    std::vector<int> v;
+    const int first = b->nlp.add_variables(n, 0.0, 0.0, 0.0);
+    for (int i = 0; i < n; ++i) v.push_back(first + i);
+    return v;
+  };
+  fesd::discretization::IntervalInputs in;
+  in.s0 = fixed(1);
+  in.lambda_start = fixed(model.n_theta());
+  in.mu_start = fixed(model.n_sys());
+  in.T = 1.0;
+  b->iv = std::make_unique<fesd::discretization::FesdInterval>(model,
+                                                               fesd::make_tableau(scheme, n_s), d);
+  b->iv->build(b->nlp, in);
+  return b;
+}
+
+// Element and neighbor groups sum products of different thetas and lambdas: not one pair that a
+// C-function could smooth.
+TEST(FischerBurmeister, NeedsGroupsWithACommonFactor) {
+  for (auto cross : {fesd::CrossComp::Element, fesd::CrossComp::Neighbor}) {
+    auto b = build(fesd::RkScheme::RadauIIA, 2, fesd::StageLambdaSign::All, cross);
+    try {
+      fesd::mpcc::Relaxation(b->nlp, b->iv->groups(), MpccMode::FischerBurmeister);
+      ADD_FAILURE() << "no exception for cross_comp_mode " << fesd::to_string(cross);
+    } catch (const fesd::InvalidOption& e) {
+      const std::string msg = e.what();
+      EXPECT_NE(msg.find("fischer_burmeister"), std::string::npos) << msg;
+      EXPECT_NE(msg.find("cross_comp_mode sparse or stage_sum"), std::string::npos) << msg;
+    }
+  }
+  for (auto cross : {fesd::CrossComp::Sparse, fesd::CrossComp::StageSum}) {
+    auto b = build(fesd::RkScheme::RadauIIA, 2, fesd::StageLambdaSign::All, cross);
+    EXPECT_NO_THROW(fesd::mpcc::Relaxation(b->nlp, b->iv->groups(), MpccMode::FischerBurmeister));
+  }
+}
+
+TEST(FischerBurmeister, IntegratorRejectsElementForm) {
+  fesd::IntegratorOptions o;
+  o.discretization.cross_comp = fesd::CrossComp::Element;
+  o.homotopy.mpcc_mode = MpccMode::FischerBurmeister;
+  Eigen::VectorXd x0(1);
+  x0 << -1.0;
+  EXPECT_THROW(fesd::integrate(crossing_model(), x0, 1.0, 2, o), fesd::InvalidOption);
+}
+
+// Free-sign lambdas (stage_lambda_sign = boundary, explicit RK: 3 elements x 2 stages x 2 regions)
+// give two-sided groups. In every mode they stay rows -sigma <= theta * lambda <= sigma, with the
+// plain product as the row function; the other groups take the mode's form.
+class TwoSided : public ::testing::TestWithParam<MpccMode> {};
+TEST_P(TwoSided, StayScholtesRowsInEveryMode) {
+  const MpccMode mode = GetParam();
+  auto b = build(fesd::RkScheme::ExplicitRK, 2, fesd::StageLambdaSign::Boundary,
+                 fesd::CrossComp::StageSum);
+  auto& nlp = b->nlp;
+  const auto& groups = b->iv->groups();
+  const fesd::mpcc::Relaxation relaxation(nlp, groups, mode);
+  const double sigma = 1e-3;
+  relaxation.set_sigma(nlp, sigma);
+  for (std::size_t i = 0; i < nlp.x_init.size(); ++i)  // a point with nonzero products
+    nlp.x_init[i] = 0.3 + 0.01 * static_cast<double>(i % 17);
+  nlp.finalize();
+  std::vector<double> g(nlp.num_constraints());
+  ASSERT_TRUE(nlp.eval_g(nlp.x_init.data(), g.data()));
+
+  ASSERT_EQ(relaxation.group_rows().size(), groups.size());
+  int two_sided = 0;
+  for (std::size_t k = 0; k < groups.size(); ++k) {
+    const int row = relaxation.group_rows()[k];
+    double product_sum = 0;
+    for (const auto& p : groups[k].pairs) product_sum += nlp.x_init[p.a] * nlp.x_init[p.b];
+    if (groups[k].two_sided) {
+      ++two_sided;
+      ASSERT_GE(row, 0);
+      EXPECT_EQ(nlp.g_lb[row], -sigma);
+      EXPECT_EQ(nlp.g_ub[row], sigma);
+      EXPECT_DOUBLE_EQ(g[row], product_sum);
+      continue;
+    }
+    switch (mode) {
+      case MpccMode::ScholtesIneq:
+        EXPECT_EQ(nlp.g_lb[row], -fesd::nlp::kInf);
+        EXPECT_EQ(nlp.g_ub[row], sigma);
+        break;
+      case MpccMode::ScholtesEq:
+        EXPECT_EQ(nlp.g_lb[row], sigma);
+        EXPECT_EQ(nlp.g_ub[row], sigma);
+        break;
+      case MpccMode::FischerBurmeister:
+        EXPECT_EQ(nlp.g_lb[row], 0.0);
+        EXPECT_EQ(nlp.g_ub[row], 0.0);
+        break;
+      case MpccMode::L1Penalty:
+        EXPECT_EQ(row, -1);  // an objective term
+        break;
+      case MpccMode::ElasticIneq:
+        EXPECT_EQ(nlp.g_ub[row], 0.0);
+        EXPECT_DOUBLE_EQ(g[row], product_sum - nlp.x_init[relaxation.elastic_variable()]);
+        break;
+    }
+  }
+  EXPECT_EQ(two_sided, 3 * 2 * 2);
+  if (mode == MpccMode::FischerBurmeister) {
+    const int v = relaxation.sigma_variable();
+    ASSERT_GE(v, 0);
+    EXPECT_EQ(nlp.x_lb[v], sigma);
+    EXPECT_EQ(nlp.x_ub[v], sigma);
+  } else {
+    EXPECT_EQ(relaxation.sigma_variable(), -1);
+  }
+  EXPECT_EQ(relaxation.elastic_variable() >= 0, mode == MpccMode::ElasticIneq);
+}
+INSTANTIATE_TEST_SUITE_P(Modes, TwoSided, ::testing::ValuesIn(kAllModes), mode_name);
+
+// ---- the option -------------------------------------------------------------------------------
+
+TEST(MpccModeOption, ReadFromProblemFilesAndOverrides) {
+  auto q = fesd::parse_simulation_problem(R"toml(
+[model]
+x = ["x"]
+c = ["x"]
+F = [["3"], ["1"]]
+x0 = [-1.0]
+[simulation]
+T_sim = 1.0
+[homotopy]
+mpcc_mode = "ell_1_penalty"
+)toml",
+                                          "mpcc.toml");
+  EXPECT_EQ(q.options.homotopy.mpcc_mode, MpccMode::L1Penalty);
+  for (MpccMode m : kAllModes) {
+    fesd::apply_override(q, "mpcc_mode", fesd::to_string(m));
+    EXPECT_EQ(q.options.homotopy.mpcc_mode, m);
+  }
+  EXPECT_EQ(fesd::IntegratorOptions{}.homotopy.mpcc_mode, MpccMode::ScholtesIneq);
+  EXPECT_THROW(fesd::apply_override(q, "homotopy.mpcc_mode", "fb"), fesd::Error);
+}
+
+}  // namespace
