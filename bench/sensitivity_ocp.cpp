@@ -2,10 +2,11 @@
 //
 // The sensitivity OCP (56) is solved from initial guesses x0 spread over [-3, 3] (the MPCC
 // initialized by a simulation from that x0 on the same grid), with Gauss-Legendre n_s = 2 and
-// N_FE = 25, for four combinations: FESD or the standard method, each with a fixed sigma = 1e-15
-// or with the homotopy sigma = 1 -> 1e-15 (factor 0.1). Prints x0* per guess, the distance to
-// the exact minimizer (9 - sqrt(417)) / 8, and per combination the worst distance, NLP
-// iterations and time.
+// N_FE = 25: FESD or the standard method, each with a fixed sigma = 1e-15 or with the homotopy
+// sigma = 1 -> 1e-15 (factor 0.1), Scholtes relaxation theta lambda <= sigma; and FESD with the
+// homotopy on theta lambda = sigma (scholtes_eq). Prints x0* per guess, the distance to the exact
+// minimizer (9 - sqrt(417)) / 8, and per combination the worst distance, NLP iterations and
+// time.
 //
 //   sensitivity_ocp [--guesses 30] [--csv FILE] [--json FILE]
 #include <cmath>
@@ -39,11 +40,15 @@ namespace {
 struct Combo {
   const char* name;
   bool fesd, homotopy;
+  fesd::MpccMode mode;
 };
-constexpr Combo kCombos[] = {{"FESD fixed", true, false},
-                             {"FESD homotopy", true, true},
-                             {"Std fixed", false, false},
-                             {"Std homotopy", false, true}};
+constexpr Combo kCombos[] = {
+    {"FESD fixed", true, false, fesd::MpccMode::ScholtesIneq},
+    {"FESD homotopy", true, true, fesd::MpccMode::ScholtesIneq},
+    {"FESD hom. eq", true, true, fesd::MpccMode::ScholtesEq},
+    {"Std fixed", false, false, fesd::MpccMode::ScholtesIneq},
+    {"Std homotopy", false, true, fesd::MpccMode::ScholtesIneq},
+};
 
 struct Run {
   double guess = 0, x0 = NAN, objective = NAN, wall_s = 0;
@@ -85,9 +90,9 @@ int main(int argc, char** argv) {
       Run r;
       r.guess = g;
       try {
-        const fesd::OcpResult res =
-            fesd::solve(fesd_bench::sensitivity_ocp(g),
-                        fesd_bench::sensitivity_options(kCombos[c].fesd, kCombos[c].homotopy));
+        const fesd::OcpResult res = fesd::solve(
+            fesd_bench::sensitivity_ocp(g),
+            fesd_bench::sensitivity_options(kCombos[c].fesd, kCombos[c].homotopy, kCombos[c].mode));
         r.x0 = res.x0()[0];
         r.objective = res.objective;
         r.wall_s = res.wall_s;
@@ -108,7 +113,9 @@ int main(int argc, char** argv) {
   fmt::print("Fig. 9 (right): OCP (56), Gauss-Legendre n_s = 2, N_FE = 25, T = 2\n");
   fmt::print("exact minimizer x0* = (9 - sqrt(417)) / 8 = {:.13f}, V* = {:.13f}\n", x_star,
              fesd_bench::kSensitivityVStar);
-  fmt::print("fixed: one NLP with sigma = 1e-15; homotopy: sigma = 1, 0.1, ..., 1e-15\n\n");
+  fmt::print(
+      "fixed: one NLP with sigma = 1e-15; homotopy: sigma = 1, 0.1, ..., 1e-15; 'eq': "
+      "theta lambda = sigma\n\n");
   std::string head = fmt::format("{:>8}", "guess");
   for (const Combo& c : kCombos) head += fmt::format(" {:>16}", c.name);
   fmt::print("{}\n", head);

@@ -33,8 +33,14 @@ enum class StepEq {
   Eta,            ///< (31): (h_n - h_{n-1}) eta_n = 0
   EtaTanh,        ///< (31) with tanh(eta_n), better scaled
   HeuristicMean,  ///< penalty rho_h * sum_n (h_n - T / N_FE)^2 in the objective (nosnoc's default)
+  /// penalty rho_h * sum_n tanh(eta_n) ((h_n - h_{n-1}) / h_0)^2: (31) as a smooth penalty. Zero
+  /// on every piecewise-uniform grid whose steps change only at switches, so unlike
+  /// heuristic_mean it does not bias a solution; unlike eta it has no corner where the grid
+  /// leaves uniformity (docs/formulation.md).
+  L2Relaxed,
 };
-/// Problem-file key `step_equilibration`: "none", "eta", "eta_tanh", "heuristic_mean".
+/// Problem-file key `step_equilibration`: "none", "eta", "eta_tanh", "heuristic_mean",
+/// "l2_relaxed".
 std::string_view to_string(StepEq v);
 bool parse(std::string_view name, StepEq& out);
 
@@ -73,13 +79,13 @@ struct DiscretizationOptions {
 /// homotopy (Sect. 5.2). sigma is the homotopy parameter of every method: sigma_0, then
 /// sigma_{k+1} = homotopy_update_slope * sigma_k down to sigma_N.
 enum class MpccMode {
-  ScholtesIneq,       ///< every complementarity constraint  w1' w2 <= sigma  (default)
-  ScholtesEq,         ///< w1' w2 = sigma
+  ScholtesIneq,  ///< every complementarity constraint  w1' w2 <= sigma  (default)
+  ScholtesEq,    ///< w1' w2 = sigma
   /// smoothed C-function  a + B - sqrt(a^2 + B^2 + 2 sigma) = 0 per group with a common factor
   /// a (B = the sum of its partners); needs cross_comp_mode sparse or stage_sum
   FischerBurmeister,
-  L1Penalty,          ///< (1 / sigma) * sum of all w1' w2 added to the objective
-  ElasticIneq,        ///< w1' w2 <= s, s >= 0 one elastic variable, (1 / sigma) * s in the objective
+  L1Penalty,    ///< (1 / sigma) * sum of all w1' w2 added to the objective
+  ElasticIneq,  ///< w1' w2 <= s, s >= 0 one elastic variable, (1 / sigma) * s in the objective
 };
 /// Problem-file key `mpcc_mode`: "scholtes_ineq", "scholtes_eq", "fischer_burmeister",
 /// "ell_1_penalty", "elastic_ineq".
@@ -92,10 +98,10 @@ bool parse(std::string_view name, MpccMode& out);
 /// complementarity_tol.
 struct HomotopyOptions {
   MpccMode mpcc_mode = MpccMode::ScholtesIneq;  ///< `mpcc_mode`
-  double sigma_0 = 1.0;                ///< `sigma_0` > 0: first relaxation
-  double homotopy_update_slope = 0.1;  ///< `homotopy_update_slope` in (0, 1)
-  double sigma_N = 1e-12;              ///< `sigma_N` > 0: smallest sigma used
-  double complementarity_tol = 1e-9;   ///< `complementarity_tol` > 0: stop when residual <= this
+  double sigma_0 = 1.0;                         ///< `sigma_0` > 0: first relaxation
+  double homotopy_update_slope = 0.1;           ///< `homotopy_update_slope` in (0, 1)
+  double sigma_N = 1e-12;                       ///< `sigma_N` > 0: smallest sigma used
+  double complementarity_tol = 1e-9;  ///< `complementarity_tol` > 0: stop when residual <= this
   /// `N_homotopy`: maximum number of NLPs per solve, 0..1000. 0 (default): enough for sigma to
   /// reach sigma_N, ceil(log(sigma_N / sigma_0) / log(slope)) + 1 (13 with the defaults).
   int max_homotopy_steps = 0;

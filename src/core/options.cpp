@@ -34,11 +34,12 @@ constexpr std::array<std::pair<CrossComp, std::string_view>, 4> kCrossComp{{
     {CrossComp::Element, "element"},
     {CrossComp::Neighbor, "neighbor"},
 }};
-constexpr std::array<std::pair<StepEq, std::string_view>, 4> kStepEq{{
+constexpr std::array<std::pair<StepEq, std::string_view>, 5> kStepEq{{
     {StepEq::None, "none"},
     {StepEq::Eta, "eta"},
     {StepEq::EtaTanh, "eta_tanh"},
     {StepEq::HeuristicMean, "heuristic_mean"},
+    {StepEq::L2Relaxed, "l2_relaxed"},
 }};
 constexpr std::array<std::pair<StageLambdaSign, std::string_view>, 3> kStageLambdaSign{{
     {StageLambdaSign::All, "all"},

@@ -137,6 +137,9 @@ struct StepEquilibrationEq {
   int h_prev = 0, h_cur = 1;
   std::vector<std::vector<int>> lam_B, lam_F, th_B, th_F;  // per region
   bool use_tanh = false;
+  /// L2Relaxed: the objective term tanh(eta_n) ((h_n - h_{n-1}) / h_scale)^2 instead of the row.
+  bool penalty = false;
+  double h_scale = 1.0;
   int num_inputs() const { return k; }
   int num_outputs() const { return 1; }
   template <class T>
@@ -156,6 +159,11 @@ struct StepEquilibrationEq {
   void operator()(const T* w, T* c) const {
     using std::tanh;
     const T e = eta(w);
+    if (penalty) {
+      const T d = (w[h_cur] - w[h_prev]) / h_scale;
+      c[0] = tanh(e) * d * d;
+      return;
+    }
     c[0] = (w[h_cur] - w[h_prev]) * (use_tanh ? tanh(e) : e);
   }
 };
@@ -322,11 +330,14 @@ void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
   step_eq_rows_.clear();
   if (fesd) {
     nlp.add_constraint(make_block(SumEq{N_FE_}), h_, in.T, in.T);  // sum h_n = T
-    if (opt_.step_eq == StepEq::Eta || opt_.step_eq == StepEq::EtaTanh) {
+    if (opt_.step_eq == StepEq::Eta || opt_.step_eq == StepEq::EtaTanh ||
+        opt_.step_eq == StepEq::L2Relaxed) {
       for (int n = 1; n < N_FE_; ++n) {  // (31)
         VarList vl;
         StepEquilibrationEq f;
         f.use_tanh = opt_.step_eq == StepEq::EtaTanh;
+        f.penalty = opt_.step_eq == StepEq::L2Relaxed;
+        f.h_scale = h0;
         f.h_prev = vl.add(h(n - 1));
         f.h_cur = vl.add(h(n));
         f.lam_B.assign(n_th, {});
@@ -344,7 +355,10 @@ void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
           }
         }
         f.k = static_cast<int>(vl.vars().size());
-        step_eq_rows_.push_back(nlp.add_constraint(make_block(f), vl.vars(), 0.0, 0.0));
+        if (f.penalty)
+          nlp.add_objective(make_block(f), vl.vars(), opt_.rho_h);
+        else
+          step_eq_rows_.push_back(nlp.add_constraint(make_block(f), vl.vars(), 0.0, 0.0));
       }
     } else if (opt_.step_eq == StepEq::HeuristicMean) {
       auto pen = make_block(SquaredDeviation{h0});

@@ -135,8 +135,8 @@ constexpr std::array<RkScheme, 5> kSchemes{RkScheme::RadauIIA, RkScheme::GaussLe
                                            RkScheme::ExplicitRK};
 constexpr std::array<CrossComp, 4> kCrossComps{CrossComp::Sparse, CrossComp::StageSum,
                                                CrossComp::Element, CrossComp::Neighbor};
-constexpr std::array<StepEq, 4> kStepEqs{StepEq::None, StepEq::Eta, StepEq::EtaTanh,
-                                         StepEq::HeuristicMean};
+constexpr std::array<StepEq, 5> kStepEqs{StepEq::None, StepEq::Eta, StepEq::EtaTanh,
+                                         StepEq::HeuristicMean, StepEq::L2Relaxed};
 constexpr std::array<StageLambdaSign, 3> kStageSigns{
     StageLambdaSign::All, StageLambdaSign::Boundary, StageLambdaSign::Auto};
 constexpr std::array<MpccMode, 5> kMpccModes{MpccMode::ScholtesIneq, MpccMode::ScholtesEq,

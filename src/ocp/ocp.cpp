@@ -404,8 +404,11 @@ bool guess_simulation(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Eige
   // A near-uniform grid: the simulation's h_n are not unique without step equilibration, and a
   // guess with elements at their bounds traps a switch at its element boundary.
   io.discretization.step_eq = StepEq::HeuristicMean;
-  io.homotopy = o.homotopy;
-  io.homotopy.mpcc_mode = MpccMode::ScholtesIneq;
+  // The simulation gets its own homotopy from sigma = 1 (the OCP's may start at a tiny fixed
+  // sigma, from which a simulation without a guess does not converge), to the OCP's tolerance.
+  io.homotopy = HomotopyOptions{};
+  io.homotopy.sigma_N = std::min(o.homotopy.sigma_N, io.homotopy.sigma_0);
+  io.homotopy.complementarity_tol = o.homotopy.complementarity_tol;
   io.nlp = o.nlp;
   io.nlp.print_level = 0;
   const Eigen::VectorXd u = ocp.u_guess.size() > 0 ? ocp.u_guess : Eigen::VectorXd::Zero(m.n_u());
