@@ -1,0 +1,46 @@
+// tests/ocp/sliding_ocp_test.cpp: the sliding-mode OCP (61) (Sect. 5.3), Radau IIA n_s = 2,
+// N_stages = 6, N_FE = 6, rho = 1e3, q_final = (-pi/6, -pi/4). The full comparison of MPCC
+// methods and step-equilibration modes is bench/sliding_ocp (docs/benchmarks.md).
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include <fesd/ocp.hpp>
+
+#include "../../bench/sliding_ocp.hpp"
+
+namespace {
+
+// Regions: 0 phi_1 > 0, 1 phi_1 < 0, 2 phi_2 > 0, 3 phi_2 < 0 (bench/sliding_ocp.hpp). Both
+// regions of a subsystem active = sliding on its surface.
+TEST(SlidingModeOcp, SwitchingSequenceOfSection53AndPiecewiseUniformGrid) {
+  const fesd::OcpResult r =
+      fesd::solve(fesd_bench::sliding_ocp_paper(), fesd_bench::sliding_options());
+  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+  EXPECT_LE(r.comp_residual, 1e-9);
+  // The l1 penalty with rho = 1e3 is exact here: q(4) = q_final (to IPOPT's tolerance).
+  EXPECT_NEAR(r.x_final()[0], -std::numbers::pi / 6, 1e-6);
+  EXPECT_NEAR(r.x_final()[1], -std::numbers::pi / 4, 1e-6);
+  // Reach one surface and slide on it, reach the co-dimension-2 set {c = 0}, stay, leave it
+  // sliding on the other surface, leave that too: four switches. (The paper's text names
+  // phi_1 first; with x(0) = (2 pi/3, pi/3, 0, 0) and v = 0, phi_2 = 0.588 is reached before
+  // phi_1 = 2.26: q' = (-1, -1) + v.)
+  const std::vector<std::vector<int>> expected = {
+      {0, 2}, {0, 2, 3}, {0, 1, 2, 3}, {0, 1, 3}, {1, 3}};
+  ASSERT_EQ(r.switches.size(), 4u);
+  EXPECT_EQ(r.switches[0].before, expected[0]);
+  for (std::size_t i = 0; i < 4; ++i) EXPECT_EQ(r.switches[i].after, expected[i + 1]) << i;
+  for (std::size_t i = 1; i < 4; ++i) EXPECT_GT(r.switches[i].t, r.switches[i - 1].t);
+  // Step equilibration: inside a control interval h changes only where the active set does
+  // (Fig. 12, middle). Tolerance 1e-6 of h0 = 1/9: the NLP is solved to 1e-12 but the penalty
+  // balances h only to its optimality tolerance.
+  for (std::size_t e = 1; e < r.h.size(); ++e) {
+    if (r.interval[e] == r.interval[e - 1] && r.active_set[e] == r.active_set[e - 1]) {
+      EXPECT_NEAR(r.h[e], r.h[e - 1], 1e-6) << "element " << e;
+    }
+  }
+}
+
+}  // namespace
