@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <map>
 #include <unordered_map>
 
 #include "fesd/error.hpp"
@@ -113,6 +114,21 @@ struct SumEq {
     T s(0.0);
     for (int i = 0; i < n; ++i) s = s + w[i];
     c[0] = s;
+  }
+};
+
+/// sum_i w_i - S = 0: a lifted sum S (inputs: S, then the summed variables). Step equilibration
+/// reads the per-element sums of lambda and theta through these variables, so each (31) block
+/// has 2 + 4 n_theta inputs instead of 2 + n_theta (2 (n_s + 2) + 2 n_s) (docs/derivatives.md).
+struct LiftedSum {
+  int k;
+  int num_inputs() const { return k; }
+  int num_outputs() const { return 1; }
+  template <class T>
+  void operator()(const T* w, T* c) const {
+    T s(0.0);
+    for (int i = 1; i < k; ++i) s = s + w[i];
+    c[0] = s - w[0];
   }
 };
 
@@ -332,6 +348,28 @@ void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
     nlp.add_constraint(make_block(SumEq{N_FE_}), h_, in.T, in.T);  // sum h_n = T
     if (opt_.step_eq == StepEq::Eta || opt_.step_eq == StepEq::EtaTanh ||
         opt_.step_eq == StepEq::L2Relaxed) {
+      // Lifted per-element sums: sigma^lambda_{n,r} over the signed points, sigma^theta_{n,r}
+      // over the stages.
+      lam_sum_.assign(N_FE_, std::vector<int>(n_th, -1));
+      th_sum_.assign(N_FE_, std::vector<int>(n_th, -1));
+      std::map<int, std::shared_ptr<const nlp::Block>> sum_blocks;
+      auto sum_block = [&](int k) {
+        auto& block = sum_blocks[k];
+        if (!block) block = make_block(LiftedSum{k});
+        return block;
+      };
+      for (int n = 0; n < N_FE_; ++n)
+        for (int r = 0; r < n_th; ++r) {
+          lam_sum_[n][r] = nlp.add_variables(1, -kInf, kInf, 0.0);
+          std::vector<int> lv{lam_sum_[n][r]};
+          for (std::size_t q = 0; q < points_[n].size(); ++q)
+            if (point_signed_[n][q]) lv.push_back(points_[n][q][r]);
+          nlp.add_constraint(sum_block(static_cast<int>(lv.size())), lv, 0.0, 0.0);
+          th_sum_[n][r] = nlp.add_variables(1, -kInf, kInf, 0.0);
+          std::vector<int> tv{th_sum_[n][r]};
+          for (int st = 0; st < n_s_; ++st) tv.push_back(theta(n, st, r));
+          nlp.add_constraint(sum_block(static_cast<int>(tv.size())), tv, 0.0, 0.0);
+        }
       for (int n = 1; n < N_FE_; ++n) {  // (31)
         VarList vl;
         StepEquilibrationEq f;
@@ -345,14 +383,10 @@ void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
         f.th_B.assign(n_th, {});
         f.th_F.assign(n_th, {});
         for (int r = 0; r < n_th; ++r) {
-          for (std::size_t q = 0; q < points_[n - 1].size(); ++q)  // signed points only
-            if (point_signed_[n - 1][q]) f.lam_B[r].push_back(vl.add(points_[n - 1][q][r]));
-          for (std::size_t q = 0; q < points_[n].size(); ++q)
-            if (point_signed_[n][q]) f.lam_F[r].push_back(vl.add(points_[n][q][r]));
-          for (int s = 0; s < n_s_; ++s) {
-            f.th_B[r].push_back(vl.add(theta(n - 1, s, r)));
-            f.th_F[r].push_back(vl.add(theta(n, s, r)));
-          }
+          f.lam_B[r].push_back(vl.add(lam_sum_[n - 1][r]));
+          f.lam_F[r].push_back(vl.add(lam_sum_[n][r]));
+          f.th_B[r].push_back(vl.add(th_sum_[n - 1][r]));
+          f.th_F[r].push_back(vl.add(th_sum_[n][r]));
         }
         f.k = static_cast<int>(vl.vars().size());
         if (f.penalty)
@@ -447,6 +481,20 @@ void FesdInterval::set_guess(nlp::BlockNlp& nlp, const Eigen::VectorXd& x0,
       for (int k = 0; k < n_sys; ++k) w[mu_end_[n][k]] = lp.mu[k];
     }
   }
+  update_lifted_guess(nlp);
+}
+
+void FesdInterval::update_lifted_guess(nlp::BlockNlp& nlp) const {
+  auto& w = nlp.x_init;
+  for (std::size_t n = 0; n < lam_sum_.size(); ++n)
+    for (std::size_t r = 0; r < lam_sum_[n].size(); ++r) {
+      double sl = 0, st = 0;
+      for (std::size_t q = 0; q < points_[n].size(); ++q)
+        if (point_signed_[n][q]) sl += w[points_[n][q][r]];
+      for (int s = 0; s < n_s_; ++s) st += w[theta(static_cast<int>(n), s, static_cast<int>(r))];
+      w[lam_sum_[n][r]] = sl;
+      w[th_sum_[n][r]] = st;
+    }
 }
 
 std::vector<double> FesdInterval::eta(const double* w) const {

@@ -94,6 +94,9 @@ class FesdInterval {
   const std::vector<CompGroup>& groups() const { return groups_; }
   /// Step-equilibration rows (31), for eta reporting; -1 if none.
   const std::vector<int>& step_eq_rows() const { return step_eq_rows_; }
+  /// Recomputes the lifted sums of step equilibration (if any) from the other entries of
+  /// nlp.x_init; call after changing the guess of lambda or theta.
+  void update_lifted_guess(nlp::BlockNlp& nlp) const;
   /// eta_n (31) at a solution x, n = 1..N_FE-1 (entry 0 unused, set to NaN).
   std::vector<double> eta(const double* x) const;
 
@@ -118,6 +121,7 @@ class FesdInterval {
   std::vector<CompPair> residual_pairs_;
   std::vector<CompGroup> groups_;
   std::vector<int> step_eq_rows_;
+  std::vector<std::vector<int>> lam_sum_, th_sum_;  // lifted sums of (31), per element, region
 };
 
 }  // namespace fesd::discretization

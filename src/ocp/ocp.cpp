@@ -445,6 +445,7 @@ bool guess_simulation(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Eige
         for (int j = 0; j < n_sys; ++j) w[iv.mu_end(n, j)] = lp.mu[j];
       }
     }
+    iv.update_lifted_guess(b.nlp);
   }
   return true;
 }

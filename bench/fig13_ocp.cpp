@@ -1,0 +1,249 @@
+// bench/fig13_ocp.cpp: Fig. 13 of papers/fesd-filippov.txt (Sect. 5.3) as a table.
+//
+// The sliding-mode OCP (61) is solved with N_stages = 6 for every RK method (Radau IIA,
+// Gauss-Legendre, Lobatto IIIC, explicit RK), n_s = 1..4 and N_FE = 1..7 (FESD: 2..7), by the
+// standard discretization and by FESD. Its optimal controls are then simulated with the FESD
+// integrator at high accuracy (Radau IIA n_s = 4, --sim-steps steps of 2 elements per control
+// interval), and E(T) = ||q_int(4) - q_final|| (REFERENCE.md: the position part) is set against
+// the CPU time of the OCP solve.
+//
+//   fig13_ocp [--schemes radau_iia,gauss_legendre,lobatto_iiic,explicit_rk] [--stages 1,2,3,4]
+//             [--N-FE 1,...,7] [--mode both|fesd|std] [--sim-steps 10] [--quick]
+//             [--csv FILE] [--json FILE] [--plot FILE.png|svg]
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <fesd/error.hpp>
+#include <fesd/integrator.hpp>
+#include <fesd/ocp.hpp>
+
+#include "bench_args.hpp"
+#include "sliding_ocp.hpp"
+
+namespace fesd_bench {
+void usage(const std::string& why, int exit_code) {
+  std::fprintf(stderr,
+               "fig13_ocp: %s\n"
+               "usage: fig13_ocp [--schemes s1,s2] [--stages 1,2] [--N-FE 1,2,...] "
+               "[--mode both|fesd|std]\n"
+               "                 [--sim-steps N] [--quick] [--csv FILE] [--json FILE] "
+               "[--plot FILE.png|svg]\n",
+               why.c_str());
+  std::exit(exit_code);
+}
+}  // namespace fesd_bench
+
+namespace {
+
+struct Run {
+  fesd::RkScheme scheme{};
+  int n_s = 0, N_FE = 0;
+  bool fesd = false;
+  std::string status;
+  double objective = NAN, cpu_s = 0, E = NAN;
+  int iterations = 0, nlps = 0;
+};
+
+/// q(4) of a high-accuracy simulation of the piecewise constant controls u_k.
+double simulate_error(const fesd::OcpResult& r, int sim_steps) {
+  const fesd::Pss model = fesd_bench::sliding_model();
+  fesd::IntegratorOptions io;
+  io.discretization.rk_scheme = fesd::RkScheme::RadauIIA;
+  io.discretization.n_s = 4;
+  io.discretization.N_FE = 2;
+  io.homotopy.complementarity_tol = 1e-12;
+  io.homotopy.sigma_N = 1e-13;
+  Eigen::VectorXd x = fesd_bench::sliding_ocp_paper().x0;
+  const double T_k = 4.0 / static_cast<double>(r.u.size());
+  for (const Eigen::VectorXd& u : r.u) {
+    const fesd::IntegratorResult s = fesd::integrate(model, x, T_k, sim_steps, io, u);
+    if (s.status != fesd::Status::Success) return NAN;
+    x = s.x_final();
+  }
+  return (x.head<2>() - fesd_bench::sliding_q_final()).norm();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<fesd::RkScheme> schemes{fesd::RkScheme::RadauIIA, fesd::RkScheme::GaussLegendre,
+                                      fesd::RkScheme::LobattoIIIC, fesd::RkScheme::ExplicitRK};
+  std::vector<int> stages{1, 2, 3, 4}, n_fe{1, 2, 3, 4, 5, 6, 7};
+  bool run_std = true, run_fesd = true;
+  int sim_steps = 10;
+  std::string csv, json_path, plot;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc) fesd_bench::usage(a + ": missing value");
+      return argv[++i];
+    };
+    if (a == "--schemes") {
+      schemes.clear();
+      for (const std::string& s : fesd_bench::split(value(), ',')) {
+        fesd::RkScheme sc{};
+        if (!fesd::parse(s, sc)) fesd_bench::usage("unknown scheme " + s);
+        schemes.push_back(sc);
+      }
+    } else if (a == "--stages") {
+      stages = fesd_bench::parse_list(a, value());
+    } else if (a == "--N-FE") {
+      n_fe = fesd_bench::parse_list(a, value());
+    } else if (a == "--mode") {
+      const std::string m = value();
+      run_std = m != "fesd";
+      run_fesd = m != "std";
+      if (m != "both" && m != "fesd" && m != "std")
+        fesd_bench::usage("--mode " + m + ": expected both, fesd or std");
+    } else if (a == "--sim-steps") {
+      sim_steps = fesd_bench::parse_int(a, value());
+    } else if (a == "--quick") {
+      schemes = {fesd::RkScheme::RadauIIA};
+      stages = {2};
+      n_fe = {2, 4};
+    } else if (a == "--csv") {
+      csv = value();
+    } else if (a == "--json") {
+      json_path = value();
+    } else if (a == "--plot") {
+      plot = value();
+    } else if (a == "-h" || a == "--help") {
+      fesd_bench::usage("Fig. 13 of the FESD paper: E(T) vs CPU time for OCP (61)", 0);
+    } else {
+      fesd_bench::usage("unknown argument " + a);
+    }
+  }
+
+  const fesd::Ocp ocp = fesd_bench::sliding_ocp_paper();
+  std::vector<Run> runs;
+  for (fesd::RkScheme scheme : schemes)
+    for (int n_s : stages) {
+      try {
+        (void)fesd::make_tableau(scheme, n_s);
+      } catch (const fesd::Error&) {
+        continue;  // e.g. Lobatto with n_s = 1
+      }
+      for (bool f : {false, true}) {
+        if ((f && !run_fesd) || (!f && !run_std)) continue;
+        for (int N : n_fe) {
+          if (f && N < 2) continue;  // FESD needs two elements to move a switch
+          Run run;
+          run.scheme = scheme;
+          run.n_s = n_s;
+          run.N_FE = N;
+          run.fesd = f;
+          fesd::OcpOptions o = fesd_bench::sliding_options();
+          o.discretization.rk_scheme = scheme;
+          o.discretization.n_s = n_s;
+          o.discretization.N_FE = N;
+          o.discretization.use_fesd = f;
+          try {
+            const fesd::OcpResult r = fesd::solve(ocp, o);
+            run.status = std::string(fesd::to_string(r.status));
+            run.objective = r.objective;
+            run.cpu_s = r.wall_s;
+            run.iterations = r.nlp_iterations;
+            run.nlps = static_cast<int>(r.homotopy.size());
+            if (r.status == fesd::Status::Success) run.E = simulate_error(r, sim_steps);
+          } catch (const fesd::Error& e) {
+            run.status = std::string("error: ") + e.what();
+          }
+          std::fprintf(stderr, "%-15s n_s=%d N_FE=%d %-4s  E(T) %.2e  %6.2f s  %4d it  %s\n",
+                       std::string(fesd::to_string(scheme)).c_str(), n_s, N, f ? "FESD" : "std",
+                       run.E, run.cpu_s, run.iterations, run.status.c_str());
+          runs.push_back(run);
+        }
+      }
+    }
+
+  fmt::print(
+      "Fig. 13: OCP (61), N_stages = 6; E(T) = ||q_int(4) - q_final|| of a Radau IIA n_s = 4 "
+      "simulation ({} steps per interval)\n\n",
+      sim_steps);
+  fmt::print("{:<16} {:>3} {:>4} {:>4} {:>10} {:>9} {:>6} {:>12}  {}\n", "scheme", "n_s", "N_FE",
+             "", "E(T)", "CPU s", "iter", "objective", "status");
+  for (const Run& r : runs)
+    fmt::print("{:<16} {:>3} {:>4} {:>4} {:>10.2e} {:>9.2f} {:>6} {:>12.6f}  {}\n",
+               fesd::to_string(r.scheme), r.n_s, r.N_FE, r.fesd ? "FESD" : "std", r.E, r.cpu_s,
+               r.iterations, r.objective, r.status);
+
+  // Summary: best E(T) per method family, and FESD vs standard at comparable CPU time.
+  auto best = [&](bool f, double max_cpu) {
+    double e = std::numeric_limits<double>::infinity();
+    for (const Run& r : runs)
+      if (r.fesd == f && std::isfinite(r.E) && r.cpu_s <= max_cpu) e = std::min(e, r.E);
+    return e;
+  };
+  fmt::print("\nbest E(T) within a CPU budget (all schemes):\n{:>10} {:>12} {:>12} {:>10}\n",
+             "budget s", "standard", "FESD", "ratio");
+  for (double budget : {1.0, 2.0, 5.0, 10.0, 1e9}) {
+    const double s = best(false, budget), f = best(true, budget);
+    fmt::print("{:>10} {:>12.2e} {:>12.2e} {:>10.1e}\n",
+               budget > 1e8 ? std::string("any") : fmt::format("{:.0f}", budget), s, f, s / f);
+  }
+
+  if (!csv.empty()) {
+    std::ofstream os(csv);
+    if (!os) fesd_bench::usage("cannot write " + csv, 1);
+    os << "rk_scheme,n_s,N_FE,use_fesd,E_T,cpu_s,iterations,nlps,objective,status\n";
+    for (const Run& r : runs)
+      os << fmt::format("{},{},{},{},{:.6e},{:.4f},{},{},{:.12g},{}\n", fesd::to_string(r.scheme),
+                        r.n_s, r.N_FE, r.fesd ? 1 : 0, r.E, r.cpu_s, r.iterations, r.nlps,
+                        r.objective, r.status);
+  }
+  if (!json_path.empty()) {
+    std::ofstream os(json_path);
+    if (!os) fesd_bench::usage("cannot write " + json_path, 1);
+    nlohmann::json j = nlohmann::json::array();
+    for (const Run& r : runs)
+      j.push_back({{"rk_scheme", std::string(fesd::to_string(r.scheme))},
+                   {"n_s", r.n_s},
+                   {"N_FE", r.N_FE},
+                   {"use_fesd", r.fesd},
+                   {"E_T", std::isfinite(r.E) ? nlohmann::json(r.E) : nlohmann::json(nullptr)},
+                   {"cpu_s", r.cpu_s},
+                   {"iterations", r.iterations},
+                   {"objective", r.objective},
+                   {"status", r.status}});
+    os << j.dump(2) << "\n";
+  }
+  if (!plot.empty()) {  // E(T) against CPU time, one point set per scheme and method
+    const std::string data = plot + ".dat";
+    std::ofstream os(data);
+    for (bool f : {false, true})
+      for (fesd::RkScheme sc : schemes) {
+        os << fmt::format("# {} {}\n", fesd::to_string(sc), f ? "FESD" : "standard");
+        for (const Run& r : runs)
+          if (r.scheme == sc && r.fesd == f && std::isfinite(r.E))
+            os << fmt::format("{:.6g} {:.6e}\n", r.cpu_s, r.E);
+        os << "\n\n";
+      }
+    os.close();
+    const bool svg = plot.size() > 4 && plot.substr(plot.size() - 4) == ".svg";
+    std::string script = fmt::format(
+        "set terminal {} size 900,600\nset output '{}'\nset logscale xy\nset xlabel 'CPU time "
+        "[s]'\nset ylabel 'E(T)'\nset key outside right\nset grid\nplot ",
+        svg ? "svg" : "pngcairo", plot);
+    int idx = 0;
+    for (bool f : {false, true})
+      for (fesd::RkScheme sc : schemes)
+        script += fmt::format("{}'{}' index {} with points pt {} title '{} {}'", idx ? ", " : "",
+                              data, idx, f ? 7 : 6, fesd::to_string(sc), f ? "FESD" : "std"),
+            ++idx;
+    script += "\n";
+    const std::string sp = plot + ".gp";
+    std::ofstream(sp) << script;
+    if (std::system(fmt::format("gnuplot '{}'", sp).c_str()) != 0)
+      std::fprintf(stderr, "fig13_ocp: gnuplot failed (data in %s)\n", data.c_str());
+  }
+  return 0;
+}
