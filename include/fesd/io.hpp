@@ -1,10 +1,11 @@
-// include/fesd/io.hpp: writing integrator results as JSON, CSV and plots. Nothing is written
-// unless one of these is called.
+// include/fesd/io.hpp: writing integrator and optimal control results as JSON, CSV and plots.
+// Nothing is written unless one of these is called.
 #pragma once
 #include <string>
 
 #include "fesd/integrator.hpp"
 #include "fesd/model.hpp"
+#include "fesd/ocp.hpp"
 
 namespace fesd {
 
@@ -17,6 +18,26 @@ void write_csv(const IntegratorResult& result, const Pss& model, const std::stri
 /// PNG or SVG (by extension) with gnuplot: states over time with switching times marked, and
 /// the step sizes h_n. Throws fesd::IoError (also if gnuplot is missing or the extension unknown).
 void write_plot(const IntegratorResult& result, const Pss& model, const std::string& path,
+                const std::string& title = "");
+
+/// JSON of an OCP solution, keys in this order: "status", "message", "objective", "t", "x" (one
+/// row per element boundary), "t_ctrl" (N_stages + 1 control grid points), "u" (one row per
+/// control interval), "h", "interval" (control interval of each element), "eta" (per element,
+/// null at interval starts), "switch_times", "x0", "x_final", "homotopy" (one object per NLP),
+/// "stats" (homotopy_steps, nlp_iterations, wall_s, derivative_s, solver_s, setup_s,
+/// n_variables, n_constraints, comp_residual, mpcc_mode), then "t_stage", "x_stage", "theta",
+/// "lambda", "active_set", "switches", "state_names", "control_names". Non-finite numbers are
+/// null. Throws fesd::IoError.
+void write_json(const OcpResult& result, const Pss& model, const std::string& path);
+/// CSV: header "t,<state names>,interval,<control names>", one row per element boundary; each row
+/// has the control of the interval it belongs to (the interval of the element starting there; the
+/// last row: the last interval). Throws fesd::IoError.
+void write_csv(const OcpResult& result, const Pss& model, const std::string& path);
+/// PNG or SVG with gnuplot, four panels over time: the states (switching times dashed), the
+/// controls as steps on the control grid, the step sizes h_n (control-interval boundaries dotted,
+/// nominal T_k / N_FE and the smallest and largest h_n dashed), and the switching indicator eta_n
+/// of (31) on a log scale (zeros, i.e. switches, marked at the bottom). Throws fesd::IoError.
+void write_plot(const OcpResult& result, const Pss& model, const std::string& path,
                 const std::string& title = "");
 
 }  // namespace fesd

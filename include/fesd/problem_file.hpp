@@ -1,5 +1,6 @@
-// include/fesd/problem_file.hpp: problem files (TOML) describing a model plus a simulation.
-// The format is documented in docs/problem-files.md; examples/ holds the paper's examples.
+// include/fesd/problem_file.hpp: problem files (TOML) describing a model plus a simulation
+// ([simulation] table) or an optimal control problem ([ocp] table). The format is documented in
+// docs/problem-files.md; examples/ holds the paper's examples.
 #pragma once
 #include <string>
 #include <string_view>
@@ -7,6 +8,7 @@
 #include <Eigen/Dense>
 
 #include "fesd/model.hpp"
+#include "fesd/ocp.hpp"
 #include "fesd/options.hpp"
 
 namespace fesd {
@@ -39,5 +41,45 @@ SimulationProblem parse_simulation_problem(std::string_view toml_text, std::stri
 /// [simulation], [discretization], [homotopy] and [ipopt] tables. Throws fesd::InvalidOption
 /// naming the key on unknown keys or bad values; re-validates the options.
 void apply_override(SimulationProblem& problem, std::string_view key, std::string_view value);
+
+/// An optimal control problem and its solver options, as read from a problem file with an [ocp]
+/// table (docs/problem-files.md, "Optimal control problems"). Solve it with
+/// fesd::solve(problem.ocp, problem.options).
+struct OcpProblem {
+  std::string name;         ///< `name`, or the file's stem
+  std::string description;  ///< `description`, may be empty
+  std::string source;       ///< file path (or the name given to parse_ocp_problem)
+  /// The OCP: model, costs and constraints (expressions compiled for every scalar type), horizon,
+  /// bounds and guesses. ocp.p holds the [model] p values; ocp.x0 is [model] x0 (the guess of x0
+  /// if [ocp] lbx0/ubx0 make it free).
+  Ocp ocp;
+  /// [discretization], [homotopy], [ipopt] and the solver keys of [ocp]. Defaults are
+  /// OcpOptions' own: step_equilibration = l2_relaxed unless the file sets it.
+  OcpOptions options;
+  /// True if an expression (of the model or of [ocp]) uses the time `t`: then a clock state "t"
+  /// with t' = 1 and t(0) = 0 is appended to x (bounds -inf..inf, fixed at 0 in lbx0/ubx0).
+  bool has_clock = false;
+};
+
+/// Reads and validates an optimal control problem file. Throws fesd::ProblemFileError /
+/// ExpressionError / InvalidOption / InvalidModel with "file:line: what is wrong" messages.
+OcpProblem load_ocp_problem(const std::string& path);
+/// Same, from text; `source_name` is used in messages.
+OcpProblem parse_ocp_problem(std::string_view toml_text, std::string_view source_name);
+
+/// Overrides one option of an OCP file as if it had been written in the file: every key of
+/// [discretization], [homotopy] and [ipopt] (as for simulation files), and the [ocp] keys T,
+/// N_stages, rho_terminal, relax_terminal_constraint, initialization and constraints_at_stages.
+/// N_finite_elements (alias N_FE) sets the same number for every control interval. Throws
+/// fesd::InvalidOption naming the key; on error the problem is unchanged.
+void apply_override(OcpProblem& problem, std::string_view key, std::string_view value);
+
+/// What a problem file describes: a simulation ([simulation]) or an optimal control problem
+/// ([ocp]).
+enum class ProblemKind { Simulation, Ocp };
+/// Reads the file's top level only: Ocp if it has an [ocp] table, else Simulation (the loaders
+/// report every other mistake). Throws fesd::ProblemFileError if the file cannot be read or is not
+/// valid TOML.
+ProblemKind problem_file_kind(const std::string& path);
 
 }  // namespace fesd

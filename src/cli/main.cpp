@@ -1,15 +1,21 @@
 // src/cli/main.cpp: the `fesd` program.
 //
 //   fesd simulate FILE [--json OUT] [--csv OUT] [--plot OUT.png|OUT.svg] [--quiet] [overrides]
+//   fesd solve FILE [--json OUT] [--csv OUT] [--plot OUT.png|OUT.svg] [--quiet] [overrides]
 //   fesd check FILE [overrides]
+//
+// `simulate` reads a simulation file ([simulation] table), `solve` an optimal control problem file
+// ([ocp] table), `check` either kind.
 //
 // Exit codes: 0 solved, 1 numerical failure (outputs are still written), 2 bad input, 3 I/O
 // failure, 4 internal error. Every error is one line on stderr: "fesd: error: <message>".
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -20,6 +26,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -29,6 +36,7 @@
 #include "fesd/error.hpp"
 #include "fesd/integrator.hpp"
 #include "fesd/io.hpp"
+#include "fesd/ocp.hpp"
 #include "fesd/options.hpp"
 #include "fesd/problem_file.hpp"
 #include "fesd/status.hpp"
@@ -74,38 +82,54 @@ void print_error(std::string_view message) {
 
 // ---- overrides -------------------------------------------------------------------------------
 
+/// Which subcommands offer an override: simulation files, OCP files, or both.
+enum class Scope { Simulation, Ocp, Both };
+
 struct OverrideKey {
   const char* key;    ///< apply_override key
   const char* names;  ///< CLI11 option names
   const char* help;
+  Scope scope;
 };
 
 constexpr OverrideKey kOverrideKeys[] = {
-    {"T_sim", "--T_sim", "[simulation] end time T_sim > 0"},
-    {"N_sim", "--N_sim", "[simulation] number of integration steps"},
+    {"T_sim", "--T_sim", "[simulation] end time T_sim > 0", Scope::Simulation},
+    {"N_sim", "--N_sim", "[simulation] number of integration steps", Scope::Simulation},
+    {"T", "--T", "[ocp] horizon T > 0", Scope::Ocp},
+    {"N_stages", "--N_stages", "[ocp] number of control intervals", Scope::Ocp},
+    {"relax_terminal_constraint", "--relax_terminal_constraint",
+     "[ocp] none or ell_1 (penalty rho_terminal)", Scope::Ocp},
+    {"rho_terminal", "--rho_terminal", "[ocp] weight of the ell_1 terminal penalty", Scope::Ocp},
+    {"initialization", "--initialization", "[ocp] initial guess: constant or simulation",
+     Scope::Ocp},
+    {"constraints_at_stages", "--constraints_at_stages",
+     "[ocp] 1: path constraints and state bounds also at the RK stage points", Scope::Ocp},
     {"rk_scheme", "--rk_scheme",
-     "radau_iia, gauss_legendre, lobatto_iiia, lobatto_iiic or explicit_rk"},
-    {"n_s", "--n_s", "Runge-Kutta stages per finite element"},
-    {"N_finite_elements", "--N_finite_elements,--N_FE", "finite elements per integration step"},
-    {"use_fesd", "--use_fesd", "1: FESD (32), 0: standard time-stepping (26)"},
-    {"cross_comp_mode", "--cross_comp_mode", "sparse, stage_sum, element or neighbor"},
+     "radau_iia, gauss_legendre, lobatto_iiia, lobatto_iiic or explicit_rk", Scope::Both},
+    {"n_s", "--n_s", "Runge-Kutta stages per finite element", Scope::Both},
+    {"N_finite_elements", "--N_finite_elements,--N_FE",
+     "finite elements per integration step (per control interval for OCPs)", Scope::Both},
+    {"use_fesd", "--use_fesd", "1: FESD (32), 0: standard time-stepping (26)", Scope::Both},
+    {"cross_comp_mode", "--cross_comp_mode", "sparse, stage_sum, element or neighbor", Scope::Both},
     {"step_equilibration", "--step_equilibration",
-     "none, eta, eta_tanh, heuristic_mean or l2_relaxed"},
+     "none, eta, eta_tanh, heuristic_mean or l2_relaxed", Scope::Both},
     {"stage_lambda_sign", "--stage_lambda_sign",
-     "where lambda >= 0 holds: all (stages), boundary (element ends) or auto"},
-    {"gamma_h", "--gamma_h", "step size freedom in (0, 1]"},
-    {"rho_h", "--rho_h", "weight of the heuristic_mean penalty"},
+     "where lambda >= 0 holds: all (stages), boundary (element ends) or auto", Scope::Both},
+    {"gamma_h", "--gamma_h", "step size freedom in (0, 1]", Scope::Both},
+    {"rho_h", "--rho_h", "weight of the heuristic_mean penalty", Scope::Both},
     {"mpcc_mode", "--mpcc_mode",
-     "scholtes_ineq, scholtes_eq, fischer_burmeister, ell_1_penalty or elastic_ineq"},
-    {"sigma_0", "--sigma_0", "first homotopy relaxation"},
-    {"homotopy_update_slope", "--homotopy_update_slope", "sigma_{k+1} = slope * sigma_k"},
-    {"sigma_N", "--sigma_N", "smallest sigma"},
-    {"complementarity_tol", "--complementarity_tol", "stop when the residual is below this"},
-    {"N_homotopy", "--N_homotopy", "maximum number of NLPs per step"},
-    {"tol", "--tol", "IPOPT tol"},
-    {"acceptable_tol", "--acceptable_tol", "IPOPT acceptable_tol"},
-    {"max_iter", "--max_iter", "IPOPT iterations per NLP"},
-    {"print_level", "--print_level", "IPOPT print_level 0..12"},
+     "scholtes_ineq, scholtes_eq, fischer_burmeister, ell_1_penalty or elastic_ineq", Scope::Both},
+    {"sigma_0", "--sigma_0", "first homotopy relaxation", Scope::Both},
+    {"homotopy_update_slope", "--homotopy_update_slope", "sigma_{k+1} = slope * sigma_k",
+     Scope::Both},
+    {"sigma_N", "--sigma_N", "smallest sigma", Scope::Both},
+    {"complementarity_tol", "--complementarity_tol", "stop when the residual is below this",
+     Scope::Both},
+    {"N_homotopy", "--N_homotopy", "maximum number of NLPs per step", Scope::Both},
+    {"tol", "--tol", "IPOPT tol", Scope::Both},
+    {"acceptable_tol", "--acceptable_tol", "IPOPT acceptable_tol", Scope::Both},
+    {"max_iter", "--max_iter", "IPOPT iterations per NLP", Scope::Both},
+    {"print_level", "--print_level", "IPOPT print_level 0..12", Scope::Both},
 };
 constexpr std::size_t kNumOverrideKeys = sizeof kOverrideKeys / sizeof kOverrideKeys[0];
 
@@ -115,8 +139,11 @@ struct Overrides {
   std::vector<CLI::Option*> options = std::vector<CLI::Option*>(kNumOverrideKeys, nullptr);
   std::vector<std::string> ipopt;
 
-  void add_to(CLI::App& app) {
+  /// Adds the options of `scope` (Both: every option, for `check`, which reads either kind).
+  void add_to(CLI::App& app, Scope scope) {
     for (std::size_t i = 0; i < kNumOverrideKeys; ++i) {
+      const Scope s = kOverrideKeys[i].scope;
+      if (scope != Scope::Both && s != Scope::Both && s != scope) continue;
       options[i] = app.add_option(kOverrideKeys[i].names, values[i], kOverrideKeys[i].help)
                        ->multi_option_policy(CLI::MultiOptionPolicy::TakeLast)
                        ->group("Overrides (as if written in the problem file)");
@@ -151,7 +178,8 @@ struct Overrides {
 /// valid only as a whole (e.g. rk_scheme = lobatto_iiia together with n_s = 2 when the file has
 /// n_s = 1) may fail in one order and succeed in another: keys that fail are retried as long as
 /// others succeed; the first remaining failure is reported.
-void apply_overrides(fesd::SimulationProblem& problem, const Overrides& overrides) {
+template <class Problem>  // fesd::SimulationProblem or fesd::OcpProblem
+void apply_overrides(Problem& problem, const Overrides& overrides) {
   std::vector<std::pair<std::string, std::string>> pending = overrides.pairs();
   while (!pending.empty()) {
     std::vector<std::pair<std::string, std::string>> failed;
@@ -248,19 +276,17 @@ std::string yes_no(bool b) {
   return b ? "1" : "0";
 }
 
-void print_header(const fesd::SimulationProblem& problem) {
-  const fesd::Pss& m = problem.model;
-  const fesd::IntegratorOptions& o = problem.options;
-  const fesd::DiscretizationOptions& d = o.discretization;
-  const fesd::HomotopyOptions& h = o.homotopy;
-  const fesd::NlpOptions& nlp = o.nlp;
-
+/// The first lines of simulation and OCP headers: name, model, x0, p. `x0_note` follows x0.
+void print_model_header(const std::string& name, const std::string& source,
+                        const std::string& description, const fesd::Pss& m, bool has_clock,
+                        const Eigen::VectorXd& x0, const std::string& x0_note,
+                        const Eigen::VectorXd& p) {
   std::string names;
   for (int i = 0; i < m.n_x(); ++i) {
-    const std::string name = static_cast<std::size_t>(i) < m.state_names.size()
-                                 ? m.state_names[static_cast<std::size_t>(i)]
-                                 : fmt::format("x{}", i + 1);
-    names += (i ? ", " : "") + name;
+    const std::string state = static_cast<std::size_t>(i) < m.state_names.size()
+                                  ? m.state_names[static_cast<std::size_t>(i)]
+                                  : fmt::format("x{}", i + 1);
+    names += (i ? ", " : "") + state;
   }
   std::string regions;
   for (int k = 0; k < m.n_sys(); ++k) {
@@ -271,19 +297,22 @@ void print_header(const fesd::SimulationProblem& problem) {
         sub.n_c > 0 ? fmt::format("n_c = {}", sub.n_c) : fmt::format("n_g = {}", sub.n_g));
   }
 
-  fmt::print("fesd {}: {} ({})\n", FESD_VERSION, problem.name, problem.source);
-  if (!problem.description.empty()) fmt::print("  {}\n", one_line(problem.description));
+  fmt::print("fesd {}: {} ({})\n", FESD_VERSION, name, source);
+  if (!description.empty()) fmt::print("  {}\n", one_line(description));
   fmt::print("  model       n_x = {} ({}), n_u = {}, n_p = {}{}\n", m.n_x(), names, m.n_u(),
-             m.n_p(), problem.has_clock ? ", with clock state t" : "");
+             m.n_p(), has_clock ? ", with clock state t" : "");
   fmt::print("  regions     {} subsystem{}, regions per subsystem: {} (n_theta = {})\n", m.n_sys(),
              m.n_sys() == 1 ? "" : "s", regions, m.n_theta());
-  fmt::print("  x0          {}\n", join_vector(problem.x0));
-  if (problem.p.size() > 0)
-    fmt::print("  p           {}\n", join_vector(problem.p, m.parameter_names));
-  if (problem.u.size() > 0)
-    fmt::print("  u           {}\n", join_vector(problem.u, m.control_names));
+  fmt::print("  x0          {}{}\n", join_vector(x0), x0_note);
+  if (p.size() > 0) fmt::print("  p           {}\n", join_vector(p, m.parameter_names));
+}
+
+/// The solver lines of the headers: discretization (N_FE as text: a number or a list), homotopy,
+/// IPOPT.
+void print_solver_header(const std::string& n_fe, const fesd::DiscretizationOptions& d,
+                         const fesd::HomotopyOptions& h, const fesd::NlpOptions& nlp) {
   fmt::print("  scheme      {}, n_s = {}, N_FE = {}, use_fesd = {}", fesd::to_string(d.rk_scheme),
-             d.n_s, d.N_FE, yes_no(d.use_fesd));
+             d.n_s, n_fe, yes_no(d.use_fesd));
   if (d.use_fesd) {
     fmt::print(" (cross_comp_mode = {}, step_equilibration = {})", fesd::to_string(d.cross_comp),
                fesd::to_string(d.step_eq));
@@ -296,43 +325,111 @@ void print_header(const fesd::SimulationProblem& problem) {
       h.complementarity_tol, h.max_homotopy_steps);
   fmt::print("  ipopt       tol = {:g}, acceptable_tol = {:g}, max_iter = {}, print_level = {}",
              nlp.tol, nlp.acceptable_tol, nlp.max_iter, nlp.print_level);
-  for (const auto& [name, value] : nlp.extra) fmt::print(", {} = {}", name, value);
+  for (const auto& [key, value] : nlp.extra) fmt::print(", {} = {}", key, value);
   fmt::print("\n");
+}
+
+void print_header(const fesd::SimulationProblem& problem) {
+  const fesd::IntegratorOptions& o = problem.options;
+  print_model_header(problem.name, problem.source, problem.description, problem.model,
+                     problem.has_clock, problem.x0, "", problem.p);
+  if (problem.u.size() > 0)
+    fmt::print("  u           {}\n", join_vector(problem.u, problem.model.control_names));
+  print_solver_header(std::to_string(o.discretization.N_FE), o.discretization, o.homotopy, o.nlp);
   fmt::print("  simulation  T_sim = {:g}, N_sim = {} (step {:g})\n", problem.T_sim, problem.N_sim,
              problem.N_sim > 0 ? problem.T_sim / problem.N_sim : 0.0);
   std::fflush(stdout);
 }
 
-fesd::SimulationProblem load(const std::string& file, const Overrides& overrides) {
+/// "[-inf, 2]" per entry, or "none".
+std::string bounds_text(const Eigen::VectorXd& lb, const Eigen::VectorXd& ub) {
+  if (lb.size() == 0 && ub.size() == 0) return "none";
+  std::string out;
+  const Eigen::Index n = std::max(lb.size(), ub.size());
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double l = i < lb.size() ? lb[i] : -INFINITY, u = i < ub.size() ? ub[i] : INFINITY;
+    out += fmt::format("{}[{:g}, {:g}]", i ? ", " : "", l, u);
+  }
+  return out;
+}
+
+void print_header(const fesd::OcpProblem& problem) {
+  const fesd::Ocp& ocp = problem.ocp;
+  const fesd::OcpOptions& o = problem.options;
+  std::string n_fe = std::to_string(o.discretization.N_FE);
+  if (!ocp.N_FE.empty()) {
+    n_fe.clear();
+    for (int n : ocp.N_FE) n_fe += fmt::format("{}{}", n_fe.empty() ? "" : ", ", n);
+    n_fe = "[" + n_fe + "]";
+  }
+  const bool free_x0 = ocp.lbx0.size() > 0;
+  print_model_header(problem.name, problem.source, problem.description, ocp.model,
+                     problem.has_clock, ocp.x0, free_x0 ? " (free: the guess)" : "", ocp.p);
+  print_solver_header(n_fe, o.discretization, o.homotopy, o.nlp);
+  const fesd::OcpFunctions* f = ocp.functions.get();
+  fmt::print("  ocp         T = {:g}, N_stages = {} (control interval {:g}), initialization = {}\n",
+             ocp.T, ocp.N_stages, ocp.N_stages > 0 ? ocp.T / ocp.N_stages : 0.0,
+             o.initialization == fesd::OcpInitialization::Simulation ? "simulation" : "constant");
+  fmt::print("  cost        Lagrange term f_q: {}, Mayer term f_q_T: {}\n",
+             f != nullptr && f->has_f_q() ? "yes" : "no",
+             f != nullptr && f->has_f_q_T() ? "yes" : "no");
+  fmt::print("  constraints {} path{}, {} terminal{}", ocp.n_g_path,
+             o.constraints_at_stages ? " (also at stage points)" : "", ocp.n_g_terminal,
+             ocp.terminal_constraint == fesd::TerminalConstraint::L1
+                 ? fmt::format(" (relaxed: ell_1, rho_terminal = {:g})", ocp.rho_terminal)
+                 : "");
+  fmt::print("\n");
+  if (free_x0) fmt::print("  bounds x0   {}\n", bounds_text(ocp.lbx0, ocp.ubx0));
+  fmt::print("  bounds x    {}\n", bounds_text(ocp.lbx, ocp.ubx));
+  if (ocp.model.n_u() > 0) {
+    fmt::print("  bounds u    {}\n", bounds_text(ocp.lbu, ocp.ubu));
+    if (ocp.u_guess.size() > 0)
+      fmt::print("  u guess     {}\n", join_vector(ocp.u_guess, ocp.model.control_names));
+  }
+  std::fflush(stdout);
+}
+
+/// Loads a problem file of either kind, applies the overrides and re-checks the options.
+template <class Problem>
+Problem load(const std::string& file, const Overrides& overrides) {
   check_input_file(file);
-  fesd::SimulationProblem problem = fesd::load_simulation_problem(file);
+  Problem problem;
+  if constexpr (std::is_same_v<Problem, fesd::OcpProblem>) {
+    problem = fesd::load_ocp_problem(file);
+  } else {
+    problem = fesd::load_simulation_problem(file);
+  }
   apply_overrides(problem, overrides);
-  fesd::check(problem.options);
+  if (const std::vector<std::string> errors = fesd::validate(problem.options); !errors.empty()) {
+    std::string all;
+    for (const std::string& e : errors) all += (all.empty() ? "" : "; ") + e;
+    throw fesd::InvalidOption(all);
+  }
   return problem;
 }
 
 // ---- subcommands -------------------------------------------------------------------------------
 
-struct SimulateArgs {
+struct SolveArgs {
   std::string file, json, csv, plot;
   bool quiet = false;
   Overrides overrides;
 };
 
 int run_check(const std::string& file, const Overrides& overrides) {
-  const fesd::SimulationProblem problem = load(file, overrides);
-  print_header(problem);
+  check_input_file(file);
+  if (fesd::problem_file_kind(file) == fesd::ProblemKind::Ocp) {
+    print_header(load<fesd::OcpProblem>(file, overrides));
+  } else {
+    print_header(load<fesd::SimulationProblem>(file, overrides));
+  }
   fmt::print("check: '{}' is valid (nothing was solved)\n", file);
   return kExitSolved;
 }
 
-int run_simulate(const SimulateArgs& args, const CLI::App& cmd) {
-  const bool want_json = cmd.count("--json") > 0, want_csv = cmd.count("--csv") > 0,
-             want_plot = cmd.count("--plot") > 0;
-  fesd::SimulationProblem problem = load(args.file, args.overrides);
-
-  // Everything that can be checked before solving is checked before solving.
-  if (want_plot) {
+/// Everything about the outputs that can be checked before solving (nothing is written).
+void check_outputs(const SolveArgs& args, const CLI::App& cmd) {
+  if (cmd.count("--plot") > 0) {
     const std::string ext = lower_extension(args.plot);
     if (ext != ".png" && ext != ".svg") {
       throw UsageError(
@@ -345,41 +442,35 @@ int run_simulate(const SimulateArgs& args, const CLI::App& cmd) {
       throw fesd::IoError("gnuplot not found: install gnuplot-nox (scripts/install-deps.sh)");
     }
   }
-  if (want_json) check_output_path("--json", args.json);
-  if (want_csv) check_output_path("--csv", args.csv);
+  if (cmd.count("--json") > 0) check_output_path("--json", args.json);
+  if (cmd.count("--csv") > 0) check_output_path("--csv", args.csv);
+}
 
-  if (!args.quiet) {
-    print_header(problem);
-    fmt::print("\n");
-    std::fflush(stdout);
-  }
-  problem.options.progress = !args.quiet;
-  const fesd::IntegratorResult result =
-      fesd::integrate(problem.model, problem.x0, problem.T_sim, problem.N_sim, problem.options,
-                      problem.u, problem.p);
+/// Prints the report, writes the outputs that were asked for (also after a numerical failure,
+/// then saying so) and returns the exit code. `what` names the run in the failure message.
+template <class Result>
+int finish(const Result& result, const std::string& report, const fesd::Pss& model,
+           const std::string& title, const SolveArgs& args, const CLI::App& cmd, const char* what) {
   std::fflush(stderr);
-  const std::string report = result.full_report();
   fmt::print("{}", report);
   if (!report.empty() && report.back() != '\n') fmt::print("\n");
 
-  // Write what was asked for, also after a numerical failure (then say so).
   const bool solved = result.status == fesd::Status::Success;
   const std::string note =
       solved ? "" : fmt::format(" (from an unsolved result: {})", fesd::to_string(result.status));
   std::vector<std::string> io_errors;
-  auto write = [&](bool wanted, const std::string& path, const char* what, auto&& writer) {
-    if (!wanted) return;
+  auto write = [&](const char* option, const std::string& path, const char* kind, auto&& writer) {
+    if (cmd.count(option) == 0) return;
     try {
       writer();
-      fmt::print("wrote {} {}{}\n", what, path, note);
+      fmt::print("wrote {} {}{}\n", kind, path, note);
     } catch (const fesd::IoError& e) {
       io_errors.emplace_back(e.what());
     }
   };
-  write(want_json, args.json, "JSON", [&] { fesd::write_json(result, problem.model, args.json); });
-  write(want_csv, args.csv, "CSV ", [&] { fesd::write_csv(result, problem.model, args.csv); });
-  write(want_plot, args.plot, "plot",
-        [&] { fesd::write_plot(result, problem.model, args.plot, problem.name); });
+  write("--json", args.json, "JSON", [&] { fesd::write_json(result, model, args.json); });
+  write("--csv", args.csv, "CSV ", [&] { fesd::write_csv(result, model, args.csv); });
+  write("--plot", args.plot, "plot", [&] { fesd::write_plot(result, model, args.plot, title); });
   std::fflush(stdout);
 
   if (!io_errors.empty()) {
@@ -392,45 +483,89 @@ int run_simulate(const SimulateArgs& args, const CLI::App& cmd) {
     return kExitIo;
   }
   if (!solved) {
-    print_error(fmt::format("the simulation failed ({}): {}", fesd::to_string(result.status),
+    print_error(fmt::format("the {} failed ({}): {}", what, fesd::to_string(result.status),
                             result.message));
   }
   return fesd::exit_code(result.status);
 }
 
+int run_simulate(const SolveArgs& args, const CLI::App& cmd) {
+  fesd::SimulationProblem problem = load<fesd::SimulationProblem>(args.file, args.overrides);
+  check_outputs(args, cmd);
+  if (!args.quiet) {
+    print_header(problem);
+    fmt::print("\n");
+    std::fflush(stdout);
+  }
+  problem.options.progress = !args.quiet;
+  const fesd::IntegratorResult result =
+      fesd::integrate(problem.model, problem.x0, problem.T_sim, problem.N_sim, problem.options,
+                      problem.u, problem.p);
+  return finish(result, result.full_report(), problem.model, problem.name, args, cmd, "simulation");
+}
+
+int run_solve(const SolveArgs& args, const CLI::App& cmd) {
+  fesd::OcpProblem problem = load<fesd::OcpProblem>(args.file, args.overrides);
+  check_outputs(args, cmd);
+  if (!args.quiet) {
+    print_header(problem);
+    fmt::print("\n");
+    std::fflush(stdout);
+  }
+  problem.options.progress = !args.quiet;
+  const fesd::OcpResult result = fesd::solve(problem.ocp, problem.options);
+  return finish(result, result.report(), problem.ocp.model, problem.name, args, cmd,
+                "optimal control problem");
+}
+
+/// Adds FILE, the output options and --quiet to `simulate` or `solve`.
+void add_solve_options(CLI::App& cmd, SolveArgs& args, const char* csv_help,
+                       const char* plot_help) {
+  cmd.add_option("FILE", args.file, "problem file (TOML)")->required();
+  cmd.add_option("--json", args.json, "write the full result as JSON")->type_name("OUT");
+  cmd.add_option("--csv", args.csv, csv_help)->type_name("OUT");
+  cmd.add_option("--plot", args.plot, plot_help)->type_name("OUT.png|OUT.svg");
+  cmd.add_flag("-q,--quiet", args.quiet, "no header, no progress lines");
+}
+
 int run(int argc, char** argv) {
   CLI::App app{
-      "fesd: simulate piecewise smooth (Filippov) systems with Finite Elements with "
-      "Switch Detection",
+      "fesd: simulate and optimally control piecewise smooth (Filippov) systems with Finite "
+      "Elements with Switch Detection",
       "fesd"};
   app.set_version_flag("--version", std::string("fesd ") + FESD_VERSION);
   app.require_subcommand(0, 1);
 
-  SimulateArgs sim;
-  CLI::App* simulate = app.add_subcommand("simulate", "solve a problem file and report the result");
-  simulate->add_option("FILE", sim.file, "problem file (TOML)")->required();
-  simulate->add_option("--json", sim.json, "write the full result as JSON")->type_name("OUT");
-  simulate->add_option("--csv", sim.csv, "write t and x at the element boundaries as CSV")
-      ->type_name("OUT");
-  simulate->add_option("--plot", sim.plot, "plot states and step sizes with gnuplot")
-      ->type_name("OUT.png|OUT.svg");
-  simulate->add_flag("-q,--quiet", sim.quiet, "no header, no progress lines");
-  sim.overrides.add_to(*simulate);
+  SolveArgs sim;
+  CLI::App* simulate = app.add_subcommand(
+      "simulate", "simulate a problem file with a [simulation] table and report the result");
+  add_solve_options(*simulate, sim, "write t and x at the element boundaries as CSV",
+                    "plot states and step sizes with gnuplot");
+  sim.overrides.add_to(*simulate, Scope::Simulation);
+
+  SolveArgs ocp;
+  CLI::App* solve = app.add_subcommand(
+      "solve", "solve an optimal control problem file (an [ocp] table) and report the result");
+  add_solve_options(*solve, ocp,
+                    "write t, x at the element boundaries and the control of each row's interval "
+                    "as CSV",
+                    "plot states, controls, step sizes and the switch indicator with gnuplot");
+  ocp.overrides.add_to(*solve, Scope::Ocp);
 
   std::string check_file;
   Overrides check_overrides;
-  CLI::App* check_cmd =
-      app.add_subcommand("check", "load and validate a problem file, do not solve");
+  CLI::App* check_cmd = app.add_subcommand(
+      "check", "load and validate a problem file (simulation or optimal control), do not solve");
   check_cmd->add_option("FILE", check_file, "problem file (TOML)")->required();
-  check_overrides.add_to(*check_cmd);
+  check_overrides.add_to(*check_cmd, Scope::Both);
 
   // The first word that is not an option must be a command (the main program has only flags).
   for (int i = 1; i < argc; ++i) {
     const std::string_view arg = argv[i];
     if (arg.empty() || arg.front() == '-') continue;
-    if (arg != "simulate" && arg != "check") {
-      print_error(
-          fmt::format("unknown command '{}' (commands: simulate, check; see fesd --help)", arg));
+    if (arg != "simulate" && arg != "solve" && arg != "check") {
+      print_error(fmt::format(
+          "unknown command '{}' (commands: simulate, solve, check; see fesd --help)", arg));
       return kExitBadInput;
     }
     break;
@@ -445,9 +580,10 @@ int run(int argc, char** argv) {
   }
 
   if (simulate->parsed()) return run_simulate(sim, *simulate);
+  if (solve->parsed()) return run_solve(ocp, *solve);
   if (check_cmd->parsed()) return run_check(check_file, check_overrides);
   std::cout << app.help() << std::flush;
-  print_error("no command given: use 'fesd simulate FILE' or 'fesd check FILE'");
+  print_error("no command given: use 'fesd simulate FILE', 'fesd solve FILE' or 'fesd check FILE'");
   return kExitBadInput;
 }
 

@@ -1,5 +1,6 @@
-// src/io/json_csv.cpp: integrator results as JSON (every field of IntegratorResult) and as CSV
-// (the states at the finite-element boundaries). See include/fesd/io.hpp.
+// src/io/json_csv.cpp: integrator and OCP results as JSON (every field of IntegratorResult /
+// OcpResult) and as CSV (the states at the finite-element boundaries, for OCPs with the controls).
+// See include/fesd/io.hpp.
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -64,21 +65,23 @@ json switches(const std::vector<SwitchEvent>& events) {
   return a;
 }
 
+json homotopy_row(const HomotopyRow& r) {
+  return json{{"k", r.k},
+              {"sigma", number(r.sigma)},
+              {"comp_residual", number(r.comp_residual)},
+              {"objective", number(r.objective)},
+              {"inf_pr", number(r.inf_pr)},
+              {"nlp_iterations", r.nlp_iterations},
+              {"nlp_status", r.nlp_status},
+              {"cpu_s", number(r.cpu_s)},
+              {"linear_solver", r.linear_solver}};
+}
+
 json homotopy(const std::vector<std::vector<HomotopyRow>>& steps) {
   json a = json::array();
   for (const std::vector<HomotopyRow>& step : steps) {
     json rows_of_step = json::array();
-    for (const HomotopyRow& r : step) {
-      rows_of_step.push_back(json{{"k", r.k},
-                                  {"sigma", number(r.sigma)},
-                                  {"comp_residual", number(r.comp_residual)},
-                                  {"objective", number(r.objective)},
-                                  {"inf_pr", number(r.inf_pr)},
-                                  {"nlp_iterations", r.nlp_iterations},
-                                  {"nlp_status", r.nlp_status},
-                                  {"cpu_s", number(r.cpu_s)},
-                                  {"linear_solver", r.linear_solver}});
-    }
+    for (const HomotopyRow& r : step) rows_of_step.push_back(homotopy_row(r));
     a.push_back(std::move(rows_of_step));
   }
   return a;
@@ -148,18 +151,26 @@ void pretty(const json& j, int depth, std::string& out) {
   }
 }
 
-std::vector<std::string> state_names_of(const IntegratorResult& result, const Pss& model) {
-  std::size_t n = static_cast<std::size_t>(model.n_x());
-  if (!result.x.empty()) n = static_cast<std::size_t>(result.x.front().size());
+/// `given[i]` where present and non-empty, else prefix + (i + 1). n: the length of the first row
+/// of `rows` if any, else `n_default`.
+std::vector<std::string> names_of(const std::vector<std::string>& given,
+                                  const std::vector<Eigen::VectorXd>& rows, int n_default,
+                                  char prefix) {
+  std::size_t n = static_cast<std::size_t>(n_default);
+  if (!rows.empty()) n = static_cast<std::size_t>(rows.front().size());
   std::vector<std::string> names(n);
   for (std::size_t i = 0; i < n; ++i) {
-    if (i < model.state_names.size() && !model.state_names[i].empty()) {
-      names[i] = model.state_names[i];
+    if (i < given.size() && !given[i].empty()) {
+      names[i] = given[i];
     } else {
-      names[i] = 'x' + std::to_string(i + 1);
+      names[i] = prefix + std::to_string(i + 1);
     }
   }
   return names;
+}
+
+std::vector<std::string> state_names_of(const IntegratorResult& result, const Pss& model) {
+  return names_of(model.state_names, result.x, model.n_x(), 'x');
 }
 
 void write_output_file(const std::string& path, const std::string& content) {
@@ -215,6 +226,93 @@ void write_csv(const IntegratorResult& result, const Pss& model, const std::stri
     for (Eigen::Index i = 0; i < result.x[n].size(); ++i) {
       out += ',';
       append_number(out, result.x[n][i]);
+    }
+    out += '\n';
+  }
+  write_output_file(path, out);
+}
+
+void write_json(const OcpResult& result, const Pss& model, const std::string& path) {
+  json j;
+  j["status"] = std::string(to_string(result.status));
+  j["message"] = result.message;
+  j["objective"] = number(result.objective);
+  j["t"] = array(result.t);
+  j["x"] = rows(result.x);
+  j["t_ctrl"] = array(result.t_ctrl);
+  j["u"] = rows(result.u);
+  j["h"] = array(result.h);
+  j["interval"] = result.interval;
+  j["eta"] = array(result.eta);
+  json switch_times = json::array();
+  for (const SwitchEvent& e : result.switches) switch_times.push_back(number(e.t));
+  j["switch_times"] = std::move(switch_times);
+  j["x0"] = array(result.x0());
+  j["x_final"] = array(result.x_final());
+  json homotopy_rows = json::array();
+  for (const HomotopyRow& r : result.homotopy) homotopy_rows.push_back(homotopy_row(r));
+  j["homotopy"] = std::move(homotopy_rows);
+  j["stats"] = json{{"homotopy_steps", result.homotopy.size()},
+                    {"nlp_iterations", result.nlp_iterations},
+                    {"wall_s", number(result.wall_s)},
+                    {"derivative_s", number(result.derivative_s)},
+                    {"solver_s", number(result.solver_s)},
+                    {"setup_s", number(result.setup_s)},
+                    {"n_variables", result.n_variables},
+                    {"n_constraints", result.n_constraints},
+                    {"comp_residual", number(result.comp_residual)},
+                    {"mpcc_mode", std::string(to_string(result.mpcc_mode))}};
+  j["t_stage"] = array(result.t_stage);
+  j["x_stage"] = rows(result.x_stage);
+  j["theta"] = rows(result.theta);
+  j["lambda"] = rows(result.lambda);
+  j["active_set"] = result.active_set;
+  j["switches"] = switches(result.switches);
+  j["state_names"] = names_of(model.state_names, result.x, model.n_x(), 'x');
+  j["control_names"] = names_of(model.control_names, result.u, model.n_u(), 'u');
+  std::string text;
+  pretty(j, 0, text);
+  text += '\n';
+  write_output_file(path, text);
+}
+
+void write_csv(const OcpResult& result, const Pss& model, const std::string& path) {
+  const std::vector<std::string> states = names_of(model.state_names, result.x, model.n_x(), 'x');
+  const std::vector<std::string> controls =
+      names_of(model.control_names, result.u, model.n_u(), 'u');
+  std::string out = "t";
+  for (const std::string& name : states) {
+    out += ',';
+    out += csv_field(name);
+  }
+  out += ",interval";
+  for (const std::string& name : controls) {
+    out += ',';
+    out += csv_field(name);
+  }
+  out += "\n";
+  const std::size_t n_rows = std::min(result.t.size(), result.x.size());
+  for (std::size_t n = 0; n < n_rows; ++n) {
+    append_number(out, result.t[n]);
+    for (Eigen::Index i = 0; i < result.x[n].size(); ++i) {
+      out += ',';
+      append_number(out, result.x[n][i]);
+    }
+    // Row n is the start of element n, which belongs to interval[n]; the final row (t = T)
+    // belongs to the last interval.
+    int k = -1;
+    if (n < result.interval.size()) {
+      k = result.interval[n];
+    } else if (!result.interval.empty()) {
+      k = result.interval.back();
+    }
+    out += ',';
+    if (k >= 0) out += std::to_string(k);
+    const bool has_u = k >= 0 && static_cast<std::size_t>(k) < result.u.size();
+    for (std::size_t i = 0; i < controls.size(); ++i) {
+      out += ',';
+      if (has_u && static_cast<Eigen::Index>(i) < result.u[static_cast<std::size_t>(k)].size())
+        append_number(out, result.u[static_cast<std::size_t>(k)][static_cast<Eigen::Index>(i)]);
     }
     out += '\n';
   }

@@ -4,7 +4,9 @@
 // Problem files: tests/bad_input/files/<mistake>.toml, one per mistake. Each starts with
 //   # expect: <ProblemFileError | ExpressionError | InvalidOption | InvalidModel>
 //   # message: <a substring the message must contain>      (one or more lines)
-// and the test loads it and checks both. Overrides (apply_override) are checked inline below.
+//   # loader: ocp                                          (optional: load_ocp_problem)
+// and the test loads it (with load_simulation_problem unless the header names the OCP loader) and
+// checks both. Overrides (apply_override) are checked inline below.
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
@@ -62,16 +64,23 @@ TEST_P(BadProblemFile, ThrowsWithMessage) {
   const std::string path = kFilesDir + "/" + GetParam();
   std::ifstream in(path);
   ASSERT_TRUE(in) << path;
-  std::string expect_kind;
+  std::string expect_kind, loader = "simulation";
   std::vector<std::string> expect_messages;
   for (std::string line; std::getline(in, line) && line.rfind('#', 0) == 0;) {
     if (line.rfind("# expect: ", 0) == 0) expect_kind = line.substr(10);
     if (line.rfind("# message: ", 0) == 0) expect_messages.push_back(line.substr(11));
+    if (line.rfind("# loader: ", 0) == 0) loader = line.substr(10);
   }
   ASSERT_FALSE(expect_kind.empty()) << path << ": no '# expect:' header";
   ASSERT_FALSE(expect_messages.empty()) << path << ": no '# message:' header";
+  ASSERT_TRUE(loader == "simulation" || loader == "ocp") << path << ": unknown loader " << loader;
 
-  const Outcome o = outcome_of([&] { load_simulation_problem(path); });
+  const Outcome o = outcome_of([&] {
+    if (loader == "ocp")
+      load_ocp_problem(path);
+    else
+      load_simulation_problem(path);
+  });
   EXPECT_EQ(o.kind, expect_kind) << o.message;
   for (const std::string& m : expect_messages)
     EXPECT_NE(o.message.find(m), std::string::npos)

@@ -3,6 +3,7 @@
 #include <sys/wait.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -21,6 +22,7 @@ namespace {
 namespace fs = std::filesystem;
 
 const std::string kOscillator = FESD_SOURCE_DIR "/examples/oscillator.toml";
+const std::string kSensitivity = FESD_SOURCE_DIR "/examples/ocp_sensitivity.toml";
 
 using fesd::testing::TempDir;
 
@@ -230,6 +232,81 @@ TEST(Cli, NothingWrittenUnlessAsked) {
   const std::string cmd = "cd " + shell_quote(dir.file("")) + " && " + shell_quote(FESD_CLI) +
                           " simulate " + shell_quote(kOscillator) +
                           " --N_sim 1 --T_sim 0.05 >/dev/null 2>&1";
+  EXPECT_EQ(std::system(cmd.c_str()), 0);
+  EXPECT_TRUE(fs::is_empty(dir.file("")));
+}
+
+// ---- fesd solve: optimal control problem files
+// ---------------------------------------------------
+
+TEST(CliSolve, HelpListsTheOcpOverrides) {
+  const CliRun r = run_cli({"solve", "--help"});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(contains(r.out, "--N_stages")) << r.out;
+  EXPECT_TRUE(contains(r.out, "--initialization")) << r.out;
+  EXPECT_TRUE(contains(r.out, "--N_FE")) << r.out;
+  EXPECT_FALSE(contains(r.out, "--T_sim")) << r.out;
+}
+
+TEST(CliSolve, CheckAcceptsOcpFiles) {
+  ASSERT_TRUE(fs::exists(kSensitivity)) << kSensitivity << " is missing";
+  const CliRun r = run_cli({"check", kSensitivity, "--N_stages", "2", "--N_FE", "5"});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(contains(r.out, "sensitivity_ocp")) << r.out;
+  EXPECT_TRUE(contains(r.out, "T = 2, N_stages = 2")) << r.out;
+  EXPECT_TRUE(contains(r.out, "N_FE = 5")) << r.out;
+  EXPECT_TRUE(contains(r.out, "step_equilibration = l2_relaxed")) << r.out;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+  // A simulation key does not apply to an OCP file.
+  const CliRun wrong = run_cli({"check", kSensitivity, "--T_sim", "1"});
+  EXPECT_EQ(wrong.code, 2);
+  EXPECT_TRUE(contains(wrong.err, "unknown option 'T_sim'")) << wrong.err;
+  EXPECT_EQ(wrong.err_lines(), 1) << wrong.err;
+}
+
+TEST(CliSolve, WrongKindOfFileExits2) {
+  const CliRun sim = run_cli({"simulate", kSensitivity});
+  EXPECT_EQ(sim.code, 2);
+  EXPECT_TRUE(contains(sim.err, "fesd solve")) << sim.err;
+  EXPECT_EQ(sim.err_lines(), 1) << sim.err;
+  const CliRun ocp = run_cli({"solve", kOscillator});
+  EXPECT_EQ(ocp.code, 2);
+  EXPECT_TRUE(contains(ocp.err, "fesd simulate")) << ocp.err;
+  EXPECT_EQ(ocp.err_lines(), 1) << ocp.err;
+  const CliRun bad = run_cli({"solve", kSensitivity, "--T", "-1"});
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_TRUE(contains(bad.err, "--T = -1: must be > 0")) << bad.err;
+  EXPECT_EQ(bad.err_lines(), 1) << bad.err;
+}
+
+// REAL SOLVE (about 1 s): the sensitivity OCP (56) as written, with every output.
+TEST(CliSolve, SolvesAndWritesRequestedOutputs) {
+  ASSERT_TRUE(fs::exists(kSensitivity)) << kSensitivity << " is missing";
+  TempDir dir;
+  const std::string json = dir.file("s.json"), csv = dir.file("s.csv");
+  const CliRun r = run_cli({"solve", kSensitivity, "--json", json, "--csv", csv});
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_TRUE(contains(r.out, "fesd optimal control: success")) << r.out;
+  EXPECT_TRUE(contains(r.out, json)) << r.out;
+  EXPECT_TRUE(contains(r.err, "sigma")) << "progress lines on stderr: " << r.err;
+
+  const nlohmann::json j = nlohmann::json::parse(read_file(json));
+  for (const char* key : {"status", "message", "objective", "t", "x", "t_ctrl", "u", "h",
+                          "interval", "eta", "switch_times", "x0", "x_final", "homotopy", "stats"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_EQ(j["status"], "success");
+  EXPECT_NEAR(j["x0"][0].get<double>(), (9.0 - std::sqrt(417.0)) / 8.0, 1e-6);
+  EXPECT_EQ(j["t"].size(), 26u);  // N_FE = 25 elements
+  EXPECT_EQ(j["stats"]["mpcc_mode"], "scholtes_eq");
+  EXPECT_EQ(read_file(csv).substr(0, 15), "t,x,interval\n0,");
+}
+
+// REAL SOLVE (a coarser grid, well under a second), run in an empty working directory.
+TEST(CliSolve, NothingWrittenUnlessAsked) {
+  ASSERT_TRUE(fs::exists(kSensitivity)) << kSensitivity << " is missing";
+  TempDir dir;
+  const std::string cmd = "cd " + shell_quote(dir.file("")) + " && " + shell_quote(FESD_CLI) +
+                          " solve " + shell_quote(kSensitivity) + " --N_FE 6 >/dev/null 2>&1";
   EXPECT_EQ(std::system(cmd.c_str()), 0);
   EXPECT_TRUE(fs::is_empty(dir.file("")));
 }

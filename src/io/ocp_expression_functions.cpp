@@ -1,0 +1,85 @@
+// src/io/ocp_expression_functions.cpp: evaluation of the parsed [ocp] expressions.
+#include "io/ocp_expression_functions.hpp"
+
+#include <string>
+#include <utility>
+
+#include <fmt/format.h>
+
+#include "fesd/error.hpp"
+
+namespace fesd {
+namespace {
+
+/// The symbol vector of one call, one buffer per thread and scalar type: after the first call it
+/// allocates nothing (the cost and constraint blocks are evaluated once per element and stage,
+/// for every derivative type).
+template <class T>
+std::vector<T>& symbol_buffer() {
+  thread_local std::vector<T> buffer;
+  return buffer;
+}
+
+}  // namespace
+
+ExpressionOcpFunctions::ExpressionOcpFunctions(ExpressionLayout layout, OcpExpressions expressions)
+    : layout_(layout), e_(std::move(expressions)) {
+  const int n_symbols = layout_.n_symbols();
+  const int first_u = layout_.n_x_slots;
+  const auto check = [&](const expr::Expression& e, const char* what, bool controls_allowed) {
+    const std::vector<int>& deps = e.dependencies();
+    if (!deps.empty() && deps.back() >= n_symbols)
+      throw InvalidModel(
+          fmt::format("ocp expressions: {} = '{}' reads input {}, but there are "
+                      "only {} symbols",
+                      what, e.text(), deps.back(), n_symbols));
+    if (!controls_allowed)
+      for (int i = first_u; i < first_u + layout_.n_u; ++i)
+        if (e.depends_on(i))
+          throw InvalidModel(
+              fmt::format("ocp expressions: {} = '{}' reads a control; it depends on x and p only",
+                          what, e.text()));
+  };
+  if (e_.f_q) check(*e_.f_q, "f_q", true);
+  if (e_.f_q_T) check(*e_.f_q_T, "f_q_T", false);
+  for (const expr::Expression& e : e_.g_path) check(e, "g_path", true);
+  for (const expr::Expression& e : e_.g_terminal) check(e, "g_terminal", false);
+}
+
+template <class T>
+void ExpressionOcpFunctions::eval(const expr::Expression* list, int n, const T* x, const T* u,
+                                  const T* p, T* out) const {
+  std::vector<T>& in = symbol_buffer<T>();
+  in.clear();
+  for (int i = 0; i < layout_.n_x; ++i) in.push_back(x[i]);
+  // The time slot of a model without a clock state: no expression reads it.
+  for (int i = layout_.n_x; i < layout_.n_x_slots; ++i) in.push_back(T(0.0));
+  for (int i = 0; i < layout_.n_u; ++i) in.push_back(u != nullptr ? u[i] : T(0.0));
+  for (int i = 0; i < layout_.n_p; ++i) in.push_back(p[i]);
+  const T* symbols = in.data();
+  for (int i = 0; i < n; ++i) out[i] = list[i].template evaluate<T>(symbols);
+}
+
+#define FESD_DEFINE_EXPRESSION_OCP_FUNCTIONS(T)                                           \
+  T ExpressionOcpFunctions::f_q(const T* x, const T* u, const T* p) const {               \
+    if (!e_.f_q) return T(0.0);                                                           \
+    T out(0.0);                                                                           \
+    eval<T>(&*e_.f_q, 1, x, u, p, &out);                                                  \
+    return out;                                                                           \
+  }                                                                                       \
+  T ExpressionOcpFunctions::f_q_T(const T* x, const T* p) const {                         \
+    if (!e_.f_q_T) return T(0.0);                                                         \
+    T out(0.0);                                                                           \
+    eval<T>(&*e_.f_q_T, 1, x, nullptr, p, &out);                                          \
+    return out;                                                                           \
+  }                                                                                       \
+  void ExpressionOcpFunctions::g_path(const T* x, const T* u, const T* p, T* out) const { \
+    eval<T>(e_.g_path.data(), n_g_path(), x, u, p, out);                                  \
+  }                                                                                       \
+  void ExpressionOcpFunctions::g_terminal(const T* x, const T* p, T* out) const {         \
+    eval<T>(e_.g_terminal.data(), n_g_terminal(), x, nullptr, p, out);                    \
+  }
+FESD_FOR_EACH_SCALAR(FESD_DEFINE_EXPRESSION_OCP_FUNCTIONS)
+#undef FESD_DEFINE_EXPRESSION_OCP_FUNCTIONS
+
+}  // namespace fesd
