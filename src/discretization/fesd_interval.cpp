@@ -6,6 +6,7 @@
 #include <unordered_map>
 
 #include "fesd/error.hpp"
+#include "nlp/sum_block.hpp"
 
 namespace fesd::discretization {
 namespace {
@@ -101,34 +102,6 @@ struct SimplexEq {
       for (int r = offsets[k]; r < offsets[k + 1]; ++r) s = s + w[r];
       c[k] = s;
     }
-  }
-};
-
-/// sum of the inputs (sum h_n = T).
-struct SumEq {
-  int n;
-  int num_inputs() const { return n; }
-  int num_outputs() const { return 1; }
-  template <class T>
-  void operator()(const T* w, T* c) const {
-    T s(0.0);
-    for (int i = 0; i < n; ++i) s = s + w[i];
-    c[0] = s;
-  }
-};
-
-/// sum_i w_i - S = 0: a lifted sum S (inputs: S, then the summed variables). Step equilibration
-/// reads the per-element sums of lambda and theta through these variables, so each (31) block
-/// has 2 + 4 n_theta inputs instead of 2 + n_theta (2 (n_s + 2) + 2 n_s) (docs/derivatives.md).
-struct LiftedSum {
-  int k;
-  int num_inputs() const { return k; }
-  int num_outputs() const { return 1; }
-  template <class T>
-  void operator()(const T* w, T* c) const {
-    T s(0.0);
-    for (int i = 1; i < k; ++i) s = s + w[i];
-    c[0] = s - w[0];
   }
 };
 
@@ -345,17 +318,18 @@ void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
 
   step_eq_rows_.clear();
   if (fesd) {
-    nlp.add_constraint(make_block(SumEq{N_FE_}), h_, in.T, in.T);  // sum h_n = T
+    nlp.add_constraint(make_block(nlp::Sum{N_FE_}), h_, in.T, in.T);  // sum h_n = T
     if (opt_.step_eq == StepEq::Eta || opt_.step_eq == StepEq::EtaTanh ||
         opt_.step_eq == StepEq::L2Relaxed) {
       // Lifted per-element sums: sigma^lambda_{n,r} over the signed points, sigma^theta_{n,r}
-      // over the stages.
+      // over the stages. Each (31) block then has 2 + 4 n_theta inputs instead of
+      // 2 + n_theta (2 (n_s + 2) + 2 n_s) (docs/derivatives.md).
       lam_sum_.assign(N_FE_, std::vector<int>(n_th, -1));
       th_sum_.assign(N_FE_, std::vector<int>(n_th, -1));
       std::map<int, std::shared_ptr<const nlp::Block>> sum_blocks;
       auto sum_block = [&](int k) {
         auto& block = sum_blocks[k];
-        if (!block) block = make_block(LiftedSum{k});
+        if (!block) block = make_block(nlp::Sum{k, /*minus_first=*/true});
         return block;
       };
       for (int n = 0; n < N_FE_; ++n)

@@ -20,6 +20,7 @@
 #include "nlp/block.hpp"
 #include "nlp/block_nlp.hpp"
 #include "nlp/ipopt_solver.hpp"
+#include "nlp/sum_block.hpp"
 
 namespace fesd {
 namespace {
@@ -108,19 +109,6 @@ struct TerminalConstraintEq {
       c[n_g + i] = c[i] + s[i];
       c[i] = c[i] - s[i];
     }
-  }
-};
-
-/// sum_i w_i (the l1 penalty of the terminal slacks, weighted by rho_terminal).
-struct SumTerm {
-  int k;
-  int num_inputs() const { return k; }
-  int num_outputs() const { return 1; }
-  template <class T>
-  void operator()(const T* w, T* c) const {
-    T s(0.0);
-    for (int i = 0; i < k; ++i) s = s + w[i];
-    c[0] = s;
   }
 };
 
@@ -362,7 +350,7 @@ std::unique_ptr<OcpNlp> build(const Ocp& ocp, const OcpOptions& o, const Eigen::
       }
       nlp.add_constraint(nlp::make_block(TerminalConstraintEq{f, n_x, n_p, n_g, true}), vars, lb2,
                          ub2);
-      nlp.add_objective(nlp::make_block(SumTerm{n_g}), b->terminal_slacks, ocp.rho_terminal);
+      nlp.add_objective(nlp::make_block(nlp::Sum{n_g}), b->terminal_slacks, ocp.rho_terminal);
     }
   }
 
