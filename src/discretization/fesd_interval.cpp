@@ -1,5 +1,6 @@
 #include "discretization/fesd_interval.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -456,6 +457,16 @@ void FesdInterval::set_guess(nlp::BlockNlp& nlp, const Eigen::VectorXd& x0,
     }
   }
   update_lifted_guess(nlp);
+}
+
+std::vector<int> FesdInterval::active_set(const double* w, int n) const {
+  std::vector<int> active;
+  for (int r = 0; r < model_.n_theta(); ++r) {
+    double th = 0;
+    for (int s = 0; s < n_s_; ++s) th = std::max(th, w[theta(n, s, r)]);
+    if (th > kActiveThetaTol) active.push_back(r);
+  }
+  return active;
 }
 
 void FesdInterval::update_lifted_guess(nlp::BlockNlp& nlp) const {

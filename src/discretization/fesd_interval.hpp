@@ -94,6 +94,12 @@ class FesdInterval {
   const std::vector<CompGroup>& groups() const { return groups_; }
   /// Step-equilibration rows (31), for eta reporting; -1 if none.
   const std::vector<int>& step_eq_rows() const { return step_eq_rows_; }
+  /// Active regions of element n at the NLP point w: theta_{n,m,r} > kActiveThetaTol at some
+  /// stage m. theta is a convex weight in [0, 1]; inactive regions have theta ~ sigma / lambda
+  /// at a relaxed solution, and lambda alone cannot decide (it vanishes for every region at a
+  /// switching boundary). Integrator and OCP report switches where this set changes.
+  std::vector<int> active_set(const double* w, int n) const;
+  static constexpr double kActiveThetaTol = 1e-6;
   /// Recomputes the lifted sums of step equilibration (if any) from the other entries of
   /// nlp.x_init; call after changing the guess of lambda or theta.
   void update_lifted_guess(nlp::BlockNlp& nlp) const;

@@ -23,7 +23,6 @@ namespace fesd {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-constexpr double kActiveThetaTol = 1e-6;
 constexpr int kMaxSplit = 2;  // a failed step is retried as halves, then quarters
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
@@ -75,15 +74,7 @@ void append_step(IntegratorResult& res, const Pss& model, const discretization::
   const int n_x = model.n_x(), n_th = model.n_theta(), n_sys = model.n_sys();
   for (int n = 0; n < iv.N_FE(); ++n) {
     const double hn = w[iv.h(n)];
-    // Active regions of the element: theta_{n,m,r} > 1e-6 at some stage. theta is a convex
-    // weight in [0, 1]; inactive regions have theta ~ sigma / lambda at the solution, and
-    // lambda alone cannot decide (it vanishes for every region at a switching boundary).
-    std::vector<int> active;
-    for (int r = 0; r < n_th; ++r) {
-      double th = 0;
-      for (int s = 0; s < iv.n_s(); ++s) th = std::max(th, w[iv.theta(n, s, r)]);
-      if (th > kActiveThetaTol) active.push_back(r);
-    }
+    const std::vector<int> active = iv.active_set(w.data(), n);
     for (int s = 0; s < iv.n_s(); ++s) {
       res.t_stage.push_back(t + tab.c(s) * hn);
       res.x_stage.push_back(gather(w, iv.X(n, s, 0), n_x));

@@ -29,7 +29,6 @@ using Clock = std::chrono::steady_clock;
 using discretization::FesdInterval;
 using discretization::IntervalInputs;
 using nlp::kInf;
-constexpr double kActiveThetaTol = 1e-6;  // as the integrator (integrator.cpp)
 
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
@@ -458,12 +457,7 @@ void extract(const OcpNlp& b, const Ocp& ocp, const std::vector<double>& w,
     const std::vector<double> eta = iv.eta(w.data());
     for (int n = 0; n < iv.N_FE(); ++n) {
       const double hn = w[iv.h(n)];
-      std::vector<int> active;
-      for (int r = 0; r < n_th; ++r) {
-        double th = 0;
-        for (int s = 0; s < iv.n_s(); ++s) th = std::max(th, w[iv.theta(n, s, r)]);
-        if (th > kActiveThetaTol) active.push_back(r);
-      }
+      const std::vector<int> active = iv.active_set(w.data(), n);
       double quad = 0;
       for (int s = 0; s < iv.n_s(); ++s) {
         res.t_stage.push_back(t + b.tab.c(s) * hn);
