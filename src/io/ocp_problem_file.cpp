@@ -381,20 +381,10 @@ ProblemKind problem_file_kind(const std::string& path) {
 }
 
 void apply_override(OcpProblem& problem, std::string_view key_in, std::string_view value_in) {
-  std::string_view key = key_in;
-  while (!key.empty() && key.front() == '-') key.remove_prefix(1);
-  const std::string value = trim(value_in);
-  const std::string head = fmt::format("--{} = {}", key, value);
-
-  // Optional "table." prefix.
-  std::string_view table;
-  if (const std::size_t dot = key.find('.'); dot != std::string_view::npos) {
-    table = key.substr(0, dot);
-    key = key.substr(dot + 1);
-    if (std::find(kTables.begin(), kTables.end(), table) == kTables.end())
-      override_error(head, fmt::format("unknown table '{}' {}", table, key_hint(table, kTables)));
-  }
-  if (key == "N_FE") key = "N_finite_elements";
+  const OverrideArg arg = parse_override_arg(key_in, value_in, kTables);
+  const std::string_view table = arg.table, key = arg.key;
+  const std::string& value = arg.value;
+  const std::string& head = arg.head;
 
   OcpProblem updated = problem;
   const OptionSpec<Op>* spec = nullptr;
@@ -406,13 +396,7 @@ void apply_override(OcpProblem& problem, std::string_view key_in, std::string_vi
     // One number for every control interval replaces a per-interval list.
     if (spec->key == "N_finite_elements") updated.ocp.N_FE.clear();
   } else if (table == "ipopt" && !key.empty()) {
-    auto& extra = updated.options.nlp.extra;
-    const auto it =
-        std::find_if(extra.begin(), extra.end(), [&](const auto& kv) { return kv.first == key; });
-    if (it != extra.end())
-      it->second = value;
-    else
-      extra.emplace_back(std::string(key), value);
+    set_ipopt_option(updated.options.nlp.extra, key, value);
   } else {
     std::vector<std::string_view> valid;
     for (const OptionSpec<Op>& o : kOptions)

@@ -151,24 +151,15 @@ SimulationProblem load_simulation_problem(const std::string& path) {
   return parse_simulation_problem(read_problem_text(path), path);
 }
 
+constexpr std::array<std::string_view, 4> kOverrideTables{"simulation", "discretization",
+                                                          "homotopy", "ipopt"};
+
 void apply_override(SimulationProblem& problem, std::string_view key_in,
                     std::string_view value_in) {
-  std::string_view key = key_in;
-  while (!key.empty() && key.front() == '-') key.remove_prefix(1);
-  const std::string value = trim(value_in);
-  const std::string head = fmt::format("--{} = {}", key, value);
-
-  // Optional "table." prefix.
-  std::string_view table;
-  if (const std::size_t dot = key.find('.'); dot != std::string_view::npos) {
-    table = key.substr(0, dot);
-    key = key.substr(dot + 1);
-    constexpr std::array<std::string_view, 4> kTables{"simulation", "discretization", "homotopy",
-                                                      "ipopt"};
-    if (std::find(kTables.begin(), kTables.end(), table) == kTables.end())
-      override_error(head, fmt::format("unknown table '{}' {}", table, key_hint(table, kTables)));
-  }
-  if (key == "N_FE") key = "N_finite_elements";
+  const OverrideArg arg = parse_override_arg(key_in, value_in, kOverrideTables);
+  const std::string_view table = arg.table, key = arg.key;
+  const std::string& value = arg.value;
+  const std::string& head = arg.head;
 
   SimulationProblem updated = problem;
   const OptionSpec<Sp>* spec = nullptr;
@@ -200,16 +191,10 @@ void apply_override(SimulationProblem& problem, std::string_view key_in,
                       count(static_cast<std::size_t>(updated.model.n_u()), "number"), u.size()));
     updated.u = Eigen::Map<const Eigen::VectorXd>(u.data(), static_cast<Eigen::Index>(u.size()));
   } else if (table == "ipopt" && !key.empty()) {
-    auto& extra = updated.options.nlp.extra;
-    const auto it =
-        std::find_if(extra.begin(), extra.end(), [&](const auto& kv) { return kv.first == key; });
-    if (it != extra.end())
-      it->second = value;
-    else
-      extra.emplace_back(std::string(key), value);
+    set_ipopt_option(updated.options.nlp.extra, key, value);
   } else {
     std::vector<std::string_view> valid;
-    for (std::string_view t : {"simulation", "discretization", "homotopy", "ipopt"})
+    for (std::string_view t : kOverrideTables)
       if (table.empty() || t == table)
         for (std::string_view k : keys_of(t)) valid.push_back(k);
     if (table.empty() || table == "discretization") valid.push_back("N_FE");

@@ -633,6 +633,33 @@ std::optional<double> parse_double(std::string_view s) {
   return v;
 }
 
+OverrideArg parse_override_arg(std::string_view key, std::string_view value,
+                               std::span<const std::string_view> tables) {
+  OverrideArg a;
+  while (!key.empty() && key.front() == '-') key.remove_prefix(1);
+  a.value = trim(value);
+  a.head = fmt::format("--{} = {}", key, a.value);
+  if (const std::size_t dot = key.find('.'); dot != std::string_view::npos) {
+    a.table = key.substr(0, dot);
+    key = key.substr(dot + 1);
+    if (std::find(tables.begin(), tables.end(), a.table) == tables.end())
+      override_error(a.head,
+                     fmt::format("unknown table '{}' {}", a.table, key_hint(a.table, tables)));
+  }
+  a.key = key == "N_FE" ? std::string_view("N_finite_elements") : key;
+  return a;
+}
+
+void set_ipopt_option(std::vector<std::pair<std::string, std::string>>& extra, std::string_view key,
+                      const std::string& value) {
+  const auto it =
+      std::find_if(extra.begin(), extra.end(), [&](const auto& kv) { return kv.first == key; });
+  if (it != extra.end())
+    it->second = value;
+  else
+    extra.emplace_back(std::string(key), value);
+}
+
 void override_error(const std::string& head, std::string_view what) {
   throw InvalidOption(fmt::format("{}: {}", head, what));
 }

@@ -344,6 +344,18 @@ std::string trim(std::string_view s);
 /// Parses an override value of `kind` ("3", "1e-9", "true", "gauss_legendre"); throws
 /// InvalidOption "<head>: <what>". Numbers must be finite.
 OptionValue override_value(Kind kind, const std::string& value, const std::string& head);
+/// An override as given: leading dashes dropped, an optional "table." prefix split off and
+/// checked against `tables`, "N_FE" read as "N_finite_elements", the value trimmed. `head` is
+/// "--<key as given> = <value>", the start of every message about it.
+struct OverrideArg {
+  std::string_view table, key;
+  std::string value, head;
+};
+OverrideArg parse_override_arg(std::string_view key, std::string_view value,
+                               std::span<const std::string_view> tables);
+/// Sets the IPOPT option `key` to `value` in `extra`, replacing an earlier value.
+void set_ipopt_option(std::vector<std::pair<std::string, std::string>>& extra, std::string_view key,
+                      const std::string& value);
 /// Joins the validation messages of an override; the key's own "table.key = v: " prefix is
 /// dropped (the head already names it).
 [[noreturn]] void throw_override_errors(const std::string& head, std::string_view canonical_key,
