@@ -212,21 +212,35 @@ void write_json(const IntegratorResult& result, const Pss& model, const std::str
   write_output_file(path, text);
 }
 
-void write_csv(const IntegratorResult& result, const Pss& model, const std::string& path) {
-  const std::vector<std::string> names = state_names_of(result, model);
-  std::string out = "t";
+namespace {
+
+/// ",name1,name2,..." (CSV-quoted where needed).
+void append_csv_names(std::string& out, const std::vector<std::string>& names) {
   for (const std::string& name : names) {
     out += ',';
     out += csv_field(name);
   }
+}
+
+/// "t,x_1,...,x_n" of one CSV row, without the line end.
+void append_csv_state_row(std::string& out, double t, const Eigen::VectorXd& x) {
+  append_number(out, t);
+  for (Eigen::Index i = 0; i < x.size(); ++i) {
+    out += ',';
+    append_number(out, x[i]);
+  }
+}
+
+}  // namespace
+
+void write_csv(const IntegratorResult& result, const Pss& model, const std::string& path) {
+  const std::vector<std::string> names = state_names_of(result, model);
+  std::string out = "t";
+  append_csv_names(out, names);
   out += "\n";
   const std::size_t n_rows = std::min(result.t.size(), result.x.size());
   for (std::size_t n = 0; n < n_rows; ++n) {
-    append_number(out, result.t[n]);
-    for (Eigen::Index i = 0; i < result.x[n].size(); ++i) {
-      out += ',';
-      append_number(out, result.x[n][i]);
-    }
+    append_csv_state_row(out, result.t[n], result.x[n]);
     out += '\n';
   }
   write_output_file(path, out);
@@ -281,23 +295,13 @@ void write_csv(const OcpResult& result, const Pss& model, const std::string& pat
   const std::vector<std::string> controls =
       names_of(model.control_names, result.u, model.n_u(), 'u');
   std::string out = "t";
-  for (const std::string& name : states) {
-    out += ',';
-    out += csv_field(name);
-  }
+  append_csv_names(out, states);
   out += ",interval";
-  for (const std::string& name : controls) {
-    out += ',';
-    out += csv_field(name);
-  }
+  append_csv_names(out, controls);
   out += "\n";
   const std::size_t n_rows = std::min(result.t.size(), result.x.size());
   for (std::size_t n = 0; n < n_rows; ++n) {
-    append_number(out, result.t[n]);
-    for (Eigen::Index i = 0; i < result.x[n].size(); ++i) {
-      out += ',';
-      append_number(out, result.x[n][i]);
-    }
+    append_csv_state_row(out, result.t[n], result.x[n]);
     // Row n is the start of element n, which belongs to interval[n]; the final row (t = T)
     // belongs to the last interval.
     int k = -1;
