@@ -50,14 +50,20 @@ struct Summary {
   /// Steps whose homotopy failed with the chosen cross_comp_mode and were solved again with the
   /// sparse form (28) from the same start (their rows follow in `homotopy`).
   int fallback_steps = 0;
-  /// Steps that failed in both forms and were replaced by two half steps (recursively, at most
-  /// twice: quarter steps). Each half step has N_FE elements of its own, so the grid then has
-  /// more than N_sim * N_FE elements.
+  /// Steps that failed in both forms and were solved again with 2 N_FE finite elements (two
+  /// switches closer together than a step need two free element boundaries between them); such
+  /// a step has 2 N_FE elements in the grid. refine_attempts counts the tries, refined_steps the
+  /// successes; every try follows a failed attempt in `homotopy`.
+  int refine_attempts = 0;
+  int refined_steps = 0;
+  /// Steps that failed also with 2 N_FE elements and were replaced by two half steps (recursively,
+  /// at most twice: quarter steps). Each half step has N_FE elements of its own, so the grid then
+  /// has more than N_sim * N_FE elements.
   int split_steps = 0;
 };
 
 /// The result of integrate(). Time grid = all finite-element boundaries t_0 < ... < t_{N_sim N_FE}
-/// (more elements where steps were split, Summary::split_steps).
+/// (more elements where steps were refined or split, Summary::refined_steps, split_steps).
 struct IntegratorResult {
   Status status = Status::NotRun;
   std::string message = "integrate() was not called";

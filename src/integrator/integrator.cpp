@@ -2,6 +2,7 @@
 // start state (fixed variables) and a shifted initial guess.
 #include "fesd/integrator.hpp"
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -13,6 +14,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "core/report.hpp"
 #include "dcs/stewart.hpp"
 #include "discretization/fesd_interval.hpp"
 #include "fesd/error.hpp"
@@ -167,35 +169,43 @@ IntegratorResult integrate(const Pss& model, const Eigen::VectorXd& x0_in, doubl
   const DiscretizationOptions& d = options.discretization;
   const Tableau tab = make_tableau(d.rk_scheme, d.n_s);
   const int n_x = model.n_x(), n_th = model.n_theta(), n_sys = model.n_sys();
-  const int N_FE = d.N_FE, n_s = d.n_s;
+  const int n_s = d.n_s;
   const double T_step = T_sim / N_sim;
 
   // ---- the NLPs of one step ----
-  // Level k solves a step of length T_step / 2^k: a step whose homotopy fails (also in the
-  // sparse form) is retried as two half steps, up to kMaxSplit times (docs/benchmarks.md). Each
-  // level's NLP is built on first need and re-solved with new fixed inputs.
+  // Level (k, r) solves a step of length T_step / 2^k with N_FE (r = 0) or 2 N_FE (r = 1)
+  // elements. A step whose homotopy fails (also in the sparse form) is retried with 2 N_FE
+  // elements (two switches closer than a step need two free element boundaries between them),
+  // then as two half steps, up to kMaxSplit times (docs/benchmarks.md). Each level's NLP is
+  // built on first need and re-solved with new fixed inputs.
   struct Level {
     std::unique_ptr<StepNlp> primary;
     // The same step with the sparse cross complementarity (28), which the homotopy follows more
     // reliably (docs/benchmarks.md). Same variable layout, other rows. Built on first need.
     std::unique_ptr<StepNlp> fallback;
   };
-  std::vector<Level> levels(kMaxSplit + 1);
+  std::vector<std::array<Level, 2>> levels(kMaxSplit + 1);
   // scholtes_eq and fischer_burmeister impose one equation per pair: with the sparse form (28)
   // a theta gets more equations than it has freedom (IPOPT: Not_Enough_Degrees_Of_Freedom), so
   // the sparse retry is useless for them.
   const MpccMode mode = options.homotopy.mpcc_mode;
   const bool can_fall_back = d.use_fesd && d.cross_comp != CrossComp::Sparse &&
                              mode != MpccMode::ScholtesEq && mode != MpccMode::FischerBurmeister;
-  auto level_nlp = [&](int k) -> StepNlp& {
-    if (!levels[k].primary) {
-      levels[k].primary =
-          build_step_nlp(model, tab, d, T_step / std::ldexp(1.0, k), options.homotopy.mpcc_mode);
-      StepNlp& sn = *levels[k].primary;
+  auto level_options = [&](int r) {
+    DiscretizationOptions dr = d;
+    dr.N_FE = r == 0 ? d.N_FE : 2 * d.N_FE;
+    return dr;
+  };
+  auto level_nlp = [&](int k, int r) -> StepNlp& {
+    Level& level = levels[k][r];
+    if (!level.primary) {
+      level.primary = build_step_nlp(model, tab, level_options(r), T_step / std::ldexp(1.0, k),
+                                     options.homotopy.mpcc_mode);
+      StepNlp& sn = *level.primary;
       fix(sn.nlp, sn.in.q, u);
       fix(sn.nlp, sn.in.p, p);
     }
-    return *levels[k].primary;
+    return *level.primary;
   };
 
   auto xdot_at = [&](const Eigen::VectorXd& x, const Eigen::VectorXd& theta) {
@@ -208,7 +218,7 @@ IntegratorResult integrate(const Pss& model, const Eigen::VectorXd& x0_in, doubl
   Eigen::VectorXd guess_xdot = xdot_at(x0_in, guess.theta);
 
   IntegratorResult res;
-  level_nlp(0).nlp.finalize();
+  level_nlp(0, 0).nlp.finalize();
   res.summary.setup_s = seconds_since(t_start);
   nlp::IpoptSolver solver(options.nlp);
   auto account = [&](const mpcc::HomotopyResult& h) {
@@ -226,9 +236,11 @@ IntegratorResult integrate(const Pss& model, const Eigen::VectorXd& x0_in, doubl
   std::vector<double> failed_w;  // last iterate of a failed step, reported with the failure
   const discretization::FesdInterval* failed_iv = nullptr;
 
-  // Solves one step of level k from x; on success appends it to res and advances t, x, guess.
-  auto solve_step = [&](int k) -> bool {
-    StepNlp& sn = level_nlp(k);
+  // Solves one step of level (k, r) from x; on success appends it to res and advances t, x,
+  // guess.
+  auto solve_step = [&](int k, int r) -> bool {
+    StepNlp& sn = level_nlp(k, r);
+    Level& level = levels[k][r];
     nlp::BlockNlp& nlp = sn.nlp;
     const discretization::FesdInterval& iv = *sn.iv;
     const dcs::LpSolution lp = dcs::solve_lp(model, x, p);
@@ -244,13 +256,13 @@ IntegratorResult integrate(const Pss& model, const Eigen::VectorXd& x0_in, doubl
     std::vector<HomotopyRow> rows = hr.rows;
     account(hr);
     if (hr.status != Status::Success && can_fall_back) {  // same start, sparse form (28)
-      if (!levels[k].fallback) {
-        DiscretizationOptions sparse = d;
+      if (!level.fallback) {
+        DiscretizationOptions sparse = level_options(r);
         sparse.cross_comp = CrossComp::Sparse;
-        levels[k].fallback = build_step_nlp(model, tab, sparse, T_step / std::ldexp(1.0, k),
-                                            options.homotopy.mpcc_mode);
+        level.fallback = build_step_nlp(model, tab, sparse, T_step / std::ldexp(1.0, k),
+                                        options.homotopy.mpcc_mode);
       }
-      StepNlp& fb = *levels[k].fallback;
+      StepNlp& fb = *level.fallback;
       fb.nlp.x_lb = nlp.x_lb;  // same layout: fixed inputs and bounds carry over
       fb.nlp.x_ub = nlp.x_ub;
       fb.nlp.x_init = nlp.x_init;
@@ -276,16 +288,24 @@ IntegratorResult integrate(const Pss& model, const Eigen::VectorXd& x0_in, doubl
     res.summary.max_comp_residual = std::max(res.summary.max_comp_residual, hr.comp_residual);
     append_step(res, model, iv, tab, w, t);
     x = res.x.back();
-    guess.theta = gather(w, iv.theta(N_FE - 1, n_s - 1, 0), n_th);
-    guess.lambda = gather(w, iv.lambda(N_FE - 1, n_s - 1, 0), n_th);
-    guess.mu = gather(w, iv.mu(N_FE - 1, n_s - 1, 0), n_sys);
-    guess_xdot = gather(w, iv.V(N_FE - 1, n_s - 1, 0), n_x);
+    const int last = iv.N_FE() - 1;
+    guess.theta = gather(w, iv.theta(last, n_s - 1, 0), n_th);
+    guess.lambda = gather(w, iv.lambda(last, n_s - 1, 0), n_th);
+    guess.mu = gather(w, iv.mu(last, n_s - 1, 0), n_sys);
+    guess_xdot = gather(w, iv.V(last, n_s - 1, 0), n_x);
     return true;
   };
-  // Advances over one step of level k, splitting it into halves where it fails.
+  // Advances over one step of level k: retried with 2 N_FE elements where it fails, then split
+  // into halves.
   std::function<bool(int)> advance = [&](int k) -> bool {
-    if (solve_step(k)) return true;
-    if (k == kMaxSplit || !d.use_fesd) return false;
+    if (solve_step(k, 0)) return true;
+    if (!d.use_fesd) return false;
+    ++res.summary.refine_attempts;
+    if (solve_step(k, 1)) {
+      ++res.summary.refined_steps;
+      return true;
+    }
+    if (k == kMaxSplit) return false;
     ++res.summary.split_steps;
     return advance(k + 1) && advance(k + 1);
   };
@@ -342,17 +362,11 @@ std::string IntegratorResult::full_report() const {
     os << "]\n";
   }
   os << fmt::format("  switches             {}\n", switches.size());
-  for (const auto& s : switches) {
-    auto set = [](const std::vector<int>& a) {
-      std::vector<int> one_based(a.begin(), a.end());
-      for (int& v : one_based) ++v;
-      return fmt::format("{{{}}}", fmt::join(one_based, ","));
-    };
-    os << fmt::format("    t_s = {:.12g}   active regions {} -> {}\n", s.t, set(s.before),
-                      set(s.after));
-  }
-  // homotopy has one entry per solve attempt; every split adds a failed attempt.
-  const std::size_t n_steps = homotopy.size() - static_cast<std::size_t>(summary.split_steps);
+  for (const auto& s : switches) os << detail::format_switch(s);
+  // homotopy has one entry per solve attempt: a refinement follows a failed attempt, a split a
+  // failed refinement.
+  const std::size_t n_steps = homotopy.size() - static_cast<std::size_t>(summary.refine_attempts) -
+                              static_cast<std::size_t>(summary.split_steps);
   const double steps = n_steps == 0 ? 1.0 : static_cast<double>(n_steps);
   os << fmt::format("  integration steps    {}  ({} finite elements)\n", n_steps, h.size());
   os << fmt::format("  NLPs solved          {}  ({:.1f} per step)\n", summary.homotopy_steps,
@@ -363,6 +377,9 @@ std::string IntegratorResult::full_report() const {
   if (summary.fallback_steps > 0)
     os << fmt::format("  retried steps        {}  (sparse cross complementarity (28))\n",
                       summary.fallback_steps);
+  if (summary.refined_steps > 0)
+    os << fmt::format("  refined steps        {}  (solved again with 2 N_FE elements)\n",
+                      summary.refined_steps);
   if (summary.split_steps > 0)
     os << fmt::format("  split steps          {}  (retried as two half steps)\n",
                       summary.split_steps);

@@ -53,6 +53,7 @@ json stats(const Summary& s) {
               {"setup_s", number(s.setup_s)},
               {"max_comp_residual", number(s.max_comp_residual)},
               {"fallback_steps", s.fallback_steps},
+              {"refined_steps", s.refined_steps},
               {"split_steps", s.split_steps}};
 }
 

@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "core/report.hpp"
 #include "dcs/stewart.hpp"
 #include "discretization/fesd_interval.hpp"
 #include "fesd/error.hpp"
@@ -564,9 +565,7 @@ std::string OcpResult::report() const {
     os << fmt::format("  x(T)                 {}\n", vec(x.back()));
   }
   os << fmt::format("  switches             {}\n", switches.size());
-  for (const auto& s : switches)
-    os << fmt::format("    t_s = {:.10g}   active regions {{{}}} -> {{{}}}\n", s.t,
-                      fmt::join(s.before, ","), fmt::join(s.after, ","));
+  for (const auto& s : switches) os << detail::format_switch(s);
   os << fmt::format("  NLP size             {} variables, {} constraints\n", n_variables,
                     n_constraints);
   os << fmt::format("  homotopy             {} NLPs, {} IPOPT iterations\n", homotopy.size(),

@@ -190,19 +190,21 @@ TEST(Oscillator, CoarseStepsSucceedThroughTheSparseRetry) {
 
 namespace {
 // Heun (explicit RK n_s = 2) with coarse steps (N_sim = 8): the step holding the switch fails in
-// both complementarity forms (a local infeasibility of the homotopy), and the integrator retries
-// it as two half steps, each with N_FE elements of its own. Measured: 1 split, |t_s - 1| = 0.19
-// (Heun's error constant at h = pi/16 is large: E(T) = 4.6; the order test is in
-// convergence_order_test.cpp). Without the split the run fails (nlp_failed).
-TEST(Oscillator, FailedStepIsRetriedAsTwoHalfSteps) {
+// both complementarity forms (a local infeasibility of the homotopy), and the integrator solves
+// it again with 2 N_FE elements (if that failed too: as two half steps). Measured: 1 refined
+// step, no split (Heun's error constant at h = pi/16 is large: E(T) = 4.6; the order test is in
+// convergence_order_test.cpp). Without the retries the run fails (nlp_failed).
+TEST(Oscillator, FailedStepIsRetriedWithMoreElements) {
   const fesd::Pss model = fesd_bench::oscillator_model();
   const double T = std::numbers::pi / 2;
   const auto r =
       fesd::integrate(model, fesd_bench::oscillator_x0(), T, 8, options(RkScheme::ExplicitRK, 2));
   ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
-  EXPECT_GE(r.summary.split_steps, 1);
-  // Every split replaces one step by two: 2 more elements each.
-  EXPECT_EQ(r.h.size(), static_cast<std::size_t>(2 * (8 + r.summary.split_steps)));
+  EXPECT_GE(r.summary.refined_steps + r.summary.split_steps, 1);
+  EXPECT_GE(r.summary.refine_attempts, r.summary.refined_steps);
+  // A refined step has 2 N_FE = 4 elements, a split one two halves of 2: 2 more elements each.
+  EXPECT_EQ(r.h.size(),
+            static_cast<std::size_t>(2 * (8 + r.summary.refined_steps + r.summary.split_steps)));
   double sum_h = 0;
   for (double h : r.h) sum_h += h;
   EXPECT_NEAR(sum_h, T, 1e-12);
