@@ -4,7 +4,8 @@
 // initialized by a simulation from that x0 on the same grid), with Gauss-Legendre n_s = 2 and
 // N_FE = 25: FESD or the standard method, each with a fixed sigma = 1e-15 or with the homotopy
 // sigma = 1 -> 1e-15 (factor 0.1), Scholtes relaxation theta lambda <= sigma; and FESD with the
-// homotopy on theta lambda = sigma (scholtes_eq). Prints x0* per guess, the distance to the exact
+// homotopy with the sparse pairs (28) instead of the default stage sums, and on theta lambda =
+// sigma (scholtes_eq). Prints x0* per guess, the distance to the exact
 // minimizer (9 - sqrt(417)) / 8, and per combination the worst distance, NLP iterations and
 // time.
 //
@@ -41,10 +42,12 @@ struct Combo {
   const char* name;
   bool fesd, homotopy;
   fesd::MpccMode mode;
+  fesd::CrossComp cross_comp = fesd::CrossComp::StageSum;  // the OCP default
 };
 constexpr Combo kCombos[] = {
     {"FESD fixed", true, false, fesd::MpccMode::ScholtesIneq},
     {"FESD homotopy", true, true, fesd::MpccMode::ScholtesIneq},
+    {"FESD hom. sparse", true, true, fesd::MpccMode::ScholtesIneq, fesd::CrossComp::Sparse},
     {"FESD hom. eq", true, true, fesd::MpccMode::ScholtesEq},
     {"Std fixed", false, false, fesd::MpccMode::ScholtesIneq},
     {"Std homotopy", false, true, fesd::MpccMode::ScholtesIneq},
@@ -90,9 +93,10 @@ int main(int argc, char** argv) {
       Run r;
       r.guess = g;
       try {
-        const fesd::OcpResult res = fesd::solve(
-            fesd_bench::sensitivity_ocp(g),
-            fesd_bench::sensitivity_options(kCombos[c].fesd, kCombos[c].homotopy, kCombos[c].mode));
+        const fesd::OcpResult res =
+            fesd::solve(fesd_bench::sensitivity_ocp(g),
+                        fesd_bench::sensitivity_options(kCombos[c].fesd, kCombos[c].homotopy,
+                                                        kCombos[c].mode, kCombos[c].cross_comp));
         r.x0 = res.x0()[0];
         r.objective = res.objective;
         r.wall_s = res.wall_s;
@@ -145,7 +149,7 @@ int main(int argc, char** argv) {
       if (d <= 1e-6) ++within;
     }
     const double n = static_cast<double>(runs[c].size());
-    fmt::print("{:<14} {:>10} {:>14.1e} {:>10} {:>10.1f} {:>9.1f} {:>9.3f}\n", kCombos[c].name,
+    fmt::print("{:<16} {:>10} {:>14.1e} {:>10} {:>10.1f} {:>9.1f} {:>9.3f}\n", kCombos[c].name,
                fmt::format("{}/{}", solved, runs[c].size()), worst,
                fmt::format("{}/{}", within, runs[c].size()), nlps / n, iters / n, wall / n);
     jsum.push_back({{"method", kCombos[c].name},

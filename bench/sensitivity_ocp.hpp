@@ -57,13 +57,15 @@ inline fesd::Ocp sensitivity_ocp(double x0_guess) {
 /// The paper's settings: Gauss-Legendre n_s = 2, N_FE = 25, initialization by a simulation from
 /// x0_guess on the same grid; sigma from sigma_0 to 1e-15 (homotopy) or fixed at 1e-15; step
 /// equilibration l2_relaxed (the OCP default).
-inline fesd::OcpOptions sensitivity_options(bool use_fesd, bool homotopy,
-                                            fesd::MpccMode mode = fesd::MpccMode::ScholtesIneq) {
+inline fesd::OcpOptions sensitivity_options(
+    bool use_fesd, bool homotopy, fesd::MpccMode mode = fesd::MpccMode::ScholtesIneq,
+    fesd::CrossComp cross_comp = fesd::CrossComp::StageSum) {
   fesd::OcpOptions o;
   o.discretization.rk_scheme = fesd::RkScheme::GaussLegendre;
   o.discretization.n_s = 2;
   o.discretization.N_FE = 25;
   o.discretization.use_fesd = use_fesd;
+  o.discretization.cross_comp = cross_comp;
   o.initialization = fesd::OcpInitialization::Simulation;
   o.homotopy.mpcc_mode = mode;
   o.homotopy.sigma_N = 1e-15;

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "../../bench/oscillator_model.hpp"
+#include "../../bench/sliding_ocp.hpp"
 #include "fesd/integrator.hpp"
 #include "fesd/model.hpp"
 #include "support/compare.hpp"
@@ -211,5 +212,36 @@ TEST(Oscillator, FailedStepIsRetriedWithMoreElements) {
   EXPECT_NEAR(r.t.back(), T, 1e-12);
   ASSERT_EQ(r.switches.size(), 1u);
   EXPECT_NEAR(r.switches[0].t, 1.0, 0.25);
+}
+}  // namespace
+
+namespace {
+// The optimal controls of OCP (61) (Gauss-Legendre n_s = 2, N_FE = 4) drive q into the corner
+// set M = {phi_1 = phi_2 = 0}: from this state (t = 4/9 of the interval that holds the arrival)
+// the trajectory reaches phi_1 = 0 at t = 0.047058 and M at t = 0.047464 (n_s = 4 reference,
+// complementarity_tol 1e-12). The two switches are 4e-4 apart, so one step with N_FE = 2 has one
+// free boundary too few, and no half or quarter step separates them: the step fails in both
+// complementarity forms and in every split. Solved again with 2 N_FE elements it succeeds. On M
+// q stays at the origin and v' = u, so v(T) = v(0) + T u exactly.
+TEST(SlidingCorner, TwoSwitchesCloserThanAStepAreSolvedWithMoreElements) {
+  const fesd::Pss model = fesd_bench::sliding_model();
+  const Eigen::Vector4d x0(0.07632146262193863, -0.0009827817969556114, -0.6080093239784728,
+                           -0.9857758956692032);
+  const Eigen::Vector2d u(-0.5885181231190852, 0.2731145374589684);
+  const double T = 1.0 / 9.0;
+  IntegratorOptions o = options(RkScheme::RadauIIA, 2);
+  o.discretization.N_FE = 2;
+  const auto r = fesd::integrate(model, x0, T, 1, o, u);
+  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+  EXPECT_EQ(r.summary.refined_steps, 1);
+  EXPECT_EQ(r.h.size(), 4u);
+  ASSERT_FALSE(r.switches.empty());
+  EXPECT_NEAR(r.switches.front().t, 0.047058, 1e-5);
+  // Ends on M: q = 0 up to the complementarity tolerance 1e-9 (measured 5e-9); v exact.
+  EXPECT_NEAR(r.x_final()[0], 0.0, 1e-7);
+  EXPECT_NEAR(r.x_final()[1], 0.0, 1e-7);
+  EXPECT_NEAR(r.x_final()[2], x0[2] + T * u[0], 1e-12);
+  EXPECT_NEAR(r.x_final()[3], x0[3] + T * u[1], 1e-12);
+  EXPECT_EQ(r.switches.back().after, (std::vector<int>{0, 1, 2, 3}));
 }
 }  // namespace
