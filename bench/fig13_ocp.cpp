@@ -10,6 +10,7 @@
 //   fig13_ocp [--schemes radau_iia,gauss_legendre,lobatto_iiic,explicit_rk] [--stages 1,2,3,4]
 //             [--N-FE 1,...,7] [--mode both|fesd|std] [--sim-steps 6] [--quick]
 //             [--step-eq l2_relaxed|heuristic_mean|eta|none] [--comp-tol 1e-9]
+//             [--intermediate-tol TOL]
 //             [--mpcc-fesd MODE] [--mpcc-std MODE]   (mpcc_mode names, default scholtes_ineq)
 //             [--csv FILE] [--json FILE] [--plot FILE.png|svg]
 #include <algorithm>
@@ -38,7 +39,8 @@ void usage(const std::string& why, int exit_code) {
                "fig13_ocp: %s\n"
                "usage: fig13_ocp [--schemes s1,s2] [--stages 1,2] [--N-FE 1,2,...] "
                "[--mode both|fesd|std] [--step-eq NAME]\n"
-               "                 [--comp-tol TOL] [--mpcc-fesd MODE] [--mpcc-std MODE]\n"
+               "                 [--comp-tol TOL] [--intermediate-tol TOL] [--mpcc-fesd MODE] "
+               "[--mpcc-std MODE]\n"
                "                 [--sim-steps N] [--quick] [--csv FILE] [--json FILE] "
                "[--plot FILE.png|svg]\n",
                why.c_str());
@@ -86,6 +88,7 @@ int main(int argc, char** argv) {
   int sim_steps = 6;
   fesd::StepEq step_eq = fesd::StepEq::L2Relaxed;
   double comp_tol = 1e-9;
+  double intermediate_tol = fesd::OcpOptions{}.homotopy.intermediate_tol;
   fesd::MpccMode mpcc_fesd = fesd::OcpOptions{}.homotopy.mpcc_mode, mpcc_std = mpcc_fesd;
   std::string csv, json_path, plot;
   for (int i = 1; i < argc; ++i) {
@@ -114,6 +117,8 @@ int main(int argc, char** argv) {
     } else if (a == "--step-eq") {
       const std::string v = value();
       if (!fesd::parse(v, step_eq)) fesd_bench::usage("--step-eq " + v + ": unknown name");
+    } else if (a == "--intermediate-tol") {
+      intermediate_tol = fesd_bench::parse_double(a, value());
     } else if (a == "--comp-tol") {
       comp_tol = fesd_bench::parse_double(a, value());
     } else if (a == "--mpcc-fesd" || a == "--mpcc-std") {
@@ -168,6 +173,7 @@ int main(int argc, char** argv) {
           o.discretization.N_FE = N;
           o.discretization.use_fesd = f;
           o.homotopy.complementarity_tol = comp_tol;
+          o.homotopy.intermediate_tol = intermediate_tol;
           o.homotopy.mpcc_mode = f ? mpcc_fesd : mpcc_std;
           try {
             // Process CPU time (not wall time): the sweep shares a 2-core machine.
@@ -193,8 +199,9 @@ int main(int argc, char** argv) {
   fmt::print(
       "Fig. 13: OCP (61), N_stages = 6; E(T) = ||q_int(4) - q_final|| of a Radau IIA n_s = 4 "
       "simulation ({} steps per interval)\nstep equilibration {}, complementarity_tol {:.0e}, "
+      "intermediate_tol {:g}, "
       "mpcc_mode {} (FESD) / {} (standard)\n\n",
-      sim_steps, fesd::to_string(step_eq), comp_tol, fesd::to_string(mpcc_fesd),
+      sim_steps, fesd::to_string(step_eq), comp_tol, intermediate_tol, fesd::to_string(mpcc_fesd),
       fesd::to_string(mpcc_std));
   fmt::print("{:<16} {:>3} {:>4} {:>4} {:>10} {:>9} {:>6} {:>12}  {}\n", "scheme", "n_s", "N_FE",
              "", "E(T)", "CPU s", "iter", "objective", "status");

@@ -105,6 +105,12 @@ struct HomotopyOptions {
   /// `N_homotopy`: maximum number of NLPs per solve, 0..1000. 0 (default): enough for sigma to
   /// reach sigma_N, ceil(log(sigma_N / sigma_0) / log(slope)) + 1 (13 with the defaults).
   int max_homotopy_steps = 0;
+  /// `intermediate_tol` >= 0: IPOPT tol of the NLPs with sigma > 10 complementarity_tol (they
+  /// only have to be good starting points for the next NLP); the later NLPs, and one that
+  /// already meets complementarity_tol, are solved to ipopt.tol. 0: ipopt.tol for every NLP.
+  /// Measured (docs/benchmarks-ocp.md): OCP (61) 371 -> 251 IPOPT iterations, the README
+  /// oscillator 6783 -> 3603, same objective / an error of the same size (~1e-9).
+  double intermediate_tol = 1e-6;
 };
 
 /// IPOPT options (problem-file table [ipopt]). Any other IPOPT option can be passed by name.

@@ -126,6 +126,8 @@ constexpr OverrideKey kOverrideKeys[] = {
     {"complementarity_tol", "--complementarity_tol", "stop when the residual is below this",
      Scope::Both},
     {"N_homotopy", "--N_homotopy", "maximum number of NLPs per step", Scope::Both},
+    {"intermediate_tol", "--intermediate_tol",
+     "IPOPT tol of the NLPs with sigma > 10 complementarity_tol (0: tol everywhere)", Scope::Both},
     {"tol", "--tol", "IPOPT tol", Scope::Both},
     {"acceptable_tol", "--acceptable_tol", "IPOPT acceptable_tol", Scope::Both},
     {"max_iter", "--max_iter", "IPOPT iterations per NLP", Scope::Both},

@@ -75,8 +75,12 @@ std::string_view to_string(StepEq v) {
 bool parse(std::string_view name, StepEq& out) {
   return parse_from(kStepEq, name, out);
 }
-std::string_view to_string(MpccMode v) { return name_from(kMpccMode, v); }
-bool parse(std::string_view name, MpccMode& out) { return parse_from(kMpccMode, name, out); }
+std::string_view to_string(MpccMode v) {
+  return name_from(kMpccMode, v);
+}
+bool parse(std::string_view name, MpccMode& out) {
+  return parse_from(kMpccMode, name, out);
+}
 std::string_view to_string(StageLambdaSign v) {
   return name_from(kStageLambdaSign, v);
 }
@@ -120,6 +124,9 @@ std::vector<std::string> validate(const HomotopyOptions& o) {
           fmt::format("homotopy.sigma_N = {}: must be <= sigma_0 = {}", o.sigma_N, o.sigma_0));
   require(e, finite_positive(o.complementarity_tol),
           fmt::format("homotopy.complementarity_tol = {}: must be > 0", o.complementarity_tol));
+  require(e, std::isfinite(o.intermediate_tol) && o.intermediate_tol >= 0,
+          fmt::format("homotopy.intermediate_tol = {}: must be >= 0 (0: ipopt.tol everywhere)",
+                      o.intermediate_tol));
   require(e, o.max_homotopy_steps >= 0 && o.max_homotopy_steps <= 1000,
           fmt::format("homotopy.N_homotopy = {}: must be in 0..1000 (0: automatic)",
                       o.max_homotopy_steps));

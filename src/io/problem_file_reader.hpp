@@ -251,7 +251,7 @@ struct OptionSpec {
 /// The options of [discretization], [homotopy] and [ipopt], for every problem type whose
 /// `options` has members discretization, homotopy and nlp.
 template <class Problem>
-constexpr std::array<OptionSpec<Problem>, 19> solver_option_specs() {
+constexpr std::array<OptionSpec<Problem>, 20> solver_option_specs() {
   using P = Problem;
   using V = OptionValue;
   return {{
@@ -285,6 +285,8 @@ constexpr std::array<OptionSpec<Problem>, 19> solver_option_specs() {
        [](P& q, const V& v) { q.options.homotopy.complementarity_tol = v.d; }},
       {"homotopy", "N_homotopy", Kind::Int,
        [](P& q, const V& v) { q.options.homotopy.max_homotopy_steps = v.i; }},
+      {"homotopy", "intermediate_tol", Kind::Double,
+       [](P& q, const V& v) { q.options.homotopy.intermediate_tol = v.d; }},
       {"ipopt", "tol", Kind::Double, [](P& q, const V& v) { q.options.nlp.tol = v.d; }},
       {"ipopt", "acceptable_tol", Kind::Double,
        [](P& q, const V& v) { q.options.nlp.acceptable_tol = v.d; }},

@@ -5,6 +5,11 @@
 
 namespace fesd::mpcc {
 
+namespace {
+// NLPs with sigma <= this factor times complementarity_tol are solved with the configured tol.
+constexpr double kTightSigmaFactor = 10.0;
+}  // namespace
+
 double comp_residual(const double* x, const std::vector<CompPair>& pairs) {
   double r = 0.0;
   for (const CompPair& p : pairs) r = std::max(r, std::abs(x[p.a] * x[p.b]));
@@ -18,19 +23,27 @@ HomotopyResult solve_homotopy(nlp::BlockNlp& nlp, const Relaxation& relaxation,
   HomotopyResult res;
   double sigma = o.sigma_0;
   bool last_ok = false, eval_failed = false;
+  bool tight_now = false;  // solve the next NLP with the configured tolerance
   int max_steps = o.max_homotopy_steps;
   if (max_steps == 0)  // automatic: until sigma reaches sigma_N
     max_steps =
         1 + static_cast<int>(std::ceil(
                 std::log(o.sigma_N / o.sigma_0) / std::log(o.homotopy_update_slope) - 1e-9));
-  for (int k = 0; k < max_steps; ++k) {
+  // One NLP more than max_steps if the last one met the tolerance only loosely (below).
+  for (int k = 0; k < max_steps + (tight_now ? 1 : 0); ++k) {
     relaxation.set_sigma(nlp, sigma);
     // The start point carries the last sigma in the fixed sigma variable. IPOPT takes a fixed
     // variable's value from its bounds anyway; set it so the point itself is consistent (for
     // other NlpSolver backends, and in the solution returned in `it`).
     if (const int v = relaxation.sigma_variable(); v >= 0 && v < static_cast<int>(it.x.size()))
       it.x[v] = sigma;
-    const nlp::NlpResult r = solver.solve(nlp, it, /*warm_start=*/k > 0);
+    // NLPs far from the end of the homotopy only need to be good starting points for the next
+    // one: with intermediate_tol they stop earlier. The NLPs with sigma near
+    // complementarity_tol, and the last, use the configured tolerance.
+    const bool loose = !tight_now && o.intermediate_tol > 0 &&
+                       sigma > kTightSigmaFactor * o.complementarity_tol && sigma > o.sigma_N;
+    const nlp::NlpResult r =
+        solver.solve(nlp, it, /*warm_start=*/k > 0, loose ? o.intermediate_tol : 0.0);
     res.comp_residual = comp_residual(it.x.data(), residual_pairs);
     // r.objective is the NLP's objective: for ell_1_penalty and elastic_ineq it includes the
     // penalty term (1 / sigma) * (sum of groups, or s).
@@ -43,7 +56,13 @@ HomotopyResult solve_homotopy(nlp::BlockNlp& nlp, const Relaxation& relaxation,
     res.last_nlp_status = r.status;
     last_ok = r.success;
     eval_failed = r.eval_error;
-    if (last_ok && res.comp_residual <= o.complementarity_tol) break;
+    if (last_ok && res.comp_residual <= o.complementarity_tol) {
+      if (!loose) break;
+      // Complementarity already met by a loosely solved NLP: solve it again at this sigma with
+      // the configured tolerance (warm; usually a few iterations) before stopping.
+      tight_now = true;
+      continue;
+    }
     if (sigma <= o.sigma_N) break;  // sigma cannot get smaller: another NLP would repeat this one
     sigma = std::max(o.homotopy_update_slope * sigma, o.sigma_N);
   }

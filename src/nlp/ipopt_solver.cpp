@@ -225,6 +225,7 @@ void set_option(Ipopt::IpoptApplication& app, const std::string& name, const std
 struct IpoptSolver::Impl {
   Ipopt::SmartPtr<Ipopt::IpoptApplication> app;
   bool user_linear_solver = false;  // the caller chose IPOPT's linear_solver: never override it
+  double tol = 0;                   // the configured tol (NlpOptions::tol or [ipopt] extra)
 };
 
 IpoptSolver::IpoptSolver(const NlpOptions& o) : impl_(std::make_unique<Impl>()) {
@@ -244,15 +245,17 @@ IpoptSolver::IpoptSolver(const NlpOptions& o) : impl_(std::make_unique<Impl>()) 
     set_option(app, name, value);
     if (name == "linear_solver") impl_->user_linear_solver = true;
   }
+  app.Options()->GetNumericValue("tol", impl_->tol, "");
   if (app.Initialize() != Ipopt::Solve_Succeeded)
     throw InvalidOption("ipopt: initialization failed (check the [ipopt] options)");
 }
 
 IpoptSolver::~IpoptSolver() = default;
 
-NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_start) {
+NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_start, double tol) {
   const auto t0 = Clock::now();
   Ipopt::IpoptApplication& app = *impl_->app;
+  app.Options()->SetNumericValue("tol", std::max(tol, impl_->tol));
   const bool warm = warm_start && start.has_duals();
   app.Options()->SetStringValue("warm_start_init_point", warm ? "yes" : "no");
   std::string linear_solver;

@@ -22,15 +22,17 @@ struct NlpResult {
   std::string linear_solver;  ///< KKT solver used: "dense" (LAPACK LDL') or "mumps"
   int iterations = 0;
   double objective = 0, inf_pr = 0, inf_du = 0;
-  double eval_s = 0;          ///< time spent in function and derivative evaluations
-  double total_s = 0;         ///< wall time of the whole solve
+  double eval_s = 0;   ///< time spent in function and derivative evaluations
+  double total_s = 0;  ///< wall time of the whole solve
 };
 
 class NlpSolver {
  public:
   virtual ~NlpSolver() = default;
   /// Solves from `start` (x; with duals when warm-starting) and overwrites it with the solution.
-  virtual NlpResult solve(const BlockNlp& nlp, Iterate& start, bool warm_start) = 0;
+  /// tol > 0 replaces the configured convergence tolerance for this solve when it is looser
+  /// (the early NLPs of a homotopy); 0 keeps it.
+  virtual NlpResult solve(const BlockNlp& nlp, Iterate& start, bool warm_start, double tol) = 0;
 };
 
 }  // namespace fesd::nlp
