@@ -13,6 +13,8 @@
 //             [--intermediate-tol TOL]
 //             [--mpcc-fesd MODE] [--mpcc-std MODE]   (mpcc_mode names, default scholtes_ineq)
 //             [--csv FILE] [--json FILE] [--plot FILE.png|svg]
+//   fig13_ocp --merge A.csv,B.csv [--csv FILE] [--json FILE] [--plot FILE]   (no solving: the
+//             table, summary and plot of runs saved by --csv, later files replacing earlier runs)
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -21,6 +23,7 @@
 #include <fstream>
 #include <limits>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <fmt/format.h>
@@ -42,7 +45,8 @@ void usage(const std::string& why, int exit_code) {
                "                 [--comp-tol TOL] [--intermediate-tol TOL] [--mpcc-fesd MODE] "
                "[--mpcc-std MODE]\n"
                "                 [--sim-steps N] [--quick] [--csv FILE] [--json FILE] "
-               "[--plot FILE.png|svg]\n",
+               "[--plot FILE.png|svg]\n"
+               "       fig13_ocp --merge A.csv,B.csv [--csv FILE] [--json FILE] [--plot FILE]\n",
                why.c_str());
   std::exit(exit_code);
 }
@@ -78,6 +82,45 @@ double simulate_error(const fesd::OcpResult& r, int sim_steps) {
   return (x.head<2>() - fesd_bench::sliding_q_final()).norm();
 }
 
+/// Runs from CSV files written by --csv (header rk_scheme,n_s,N_FE,use_fesd,E_T,cpu_s,
+/// iterations,nlps,objective,status); a later file's run replaces an earlier one with the same
+/// scheme, n_s, N_FE and method, so partial sweeps run in parallel can be put together.
+std::vector<Run> read_runs(const std::vector<std::string>& files) {
+  std::vector<Run> runs;
+  for (const std::string& file : files) {
+    std::ifstream is(file);
+    if (!is) fesd_bench::usage("cannot read " + file, 1);
+    std::string line;
+    std::getline(is, line);  // header
+    while (std::getline(is, line)) {
+      const std::vector<std::string> f = fesd_bench::split(line, ',');
+      Run r;
+      if (f.size() != 10 || !fesd::parse(f[0], r.scheme))
+        fesd_bench::usage(file + ": not a fig13_ocp CSV line: " + line, 1);
+      r.n_s = std::stoi(f[1]);
+      r.N_FE = std::stoi(f[2]);
+      r.fesd = f[3] == "1";
+      r.E = std::strtod(f[4].c_str(), nullptr);
+      r.cpu_s = std::strtod(f[5].c_str(), nullptr);
+      r.iterations = std::stoi(f[6]);
+      r.nlps = std::stoi(f[7]);
+      r.objective = std::strtod(f[8].c_str(), nullptr);
+      r.status = f[9];
+      auto same = [&](const Run& o) {
+        return o.scheme == r.scheme && o.n_s == r.n_s && o.N_FE == r.N_FE && o.fesd == r.fesd;
+      };
+      if (auto it = std::find_if(runs.begin(), runs.end(), same); it != runs.end())
+        *it = r;
+      else
+        runs.push_back(r);
+    }
+  }
+  std::sort(runs.begin(), runs.end(), [](const Run& a, const Run& b) {
+    return std::tie(a.scheme, a.n_s, a.fesd, a.N_FE) < std::tie(b.scheme, b.n_s, b.fesd, b.N_FE);
+  });
+  return runs;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -91,6 +134,7 @@ int main(int argc, char** argv) {
   double intermediate_tol = fesd::OcpOptions{}.homotopy.intermediate_tol;
   fesd::MpccMode mpcc_fesd = fesd::OcpOptions{}.homotopy.mpcc_mode, mpcc_std = mpcc_fesd;
   std::string csv, json_path, plot;
+  std::vector<std::string> merge;  // --merge: read runs from these CSVs instead of solving
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto value = [&]() -> std::string {
@@ -135,6 +179,8 @@ int main(int argc, char** argv) {
       csv = value();
     } else if (a == "--json") {
       json_path = value();
+    } else if (a == "--merge") {
+      merge = fesd_bench::split(value(), ',');
     } else if (a == "--plot") {
       plot = value();
     } else if (a == "-h" || a == "--help") {
@@ -146,6 +192,10 @@ int main(int argc, char** argv) {
 
   const fesd::Ocp ocp = fesd_bench::sliding_ocp_paper();
   std::vector<Run> runs;
+  if (!merge.empty()) {
+    runs = read_runs(merge);
+    schemes.clear();  // nothing to solve
+  }
   for (fesd::RkScheme scheme : schemes)
     for (int n_s : stages) {
       try {
@@ -252,26 +302,35 @@ int main(int argc, char** argv) {
   }
   if (!plot.empty()) {  // E(T) against CPU time, one point set per scheme and method
     const std::string data = plot + ".dat";
+    std::vector<fesd::RkScheme> plotted;  // the schemes of the runs, in order
+    for (const Run& r : runs)
+      if (std::find(plotted.begin(), plotted.end(), r.scheme) == plotted.end())
+        plotted.push_back(r.scheme);
     std::ofstream os(data);
+    // Columns: CPU s, E(T), marker size growing with n_s (as in the paper's figure).
     for (bool f : {false, true})
-      for (fesd::RkScheme sc : schemes) {
+      for (fesd::RkScheme sc : plotted) {
         os << fmt::format("# {} {}\n", fesd::to_string(sc), f ? "FESD" : "standard");
         for (const Run& r : runs)
           if (r.scheme == sc && r.fesd == f && std::isfinite(r.E))
-            os << fmt::format("{:.6g} {:.6e}\n", r.cpu_s, r.E);
+            os << fmt::format("{:.6g} {:.6e} {:.2f}\n", r.cpu_s, r.E, 0.5 + 0.35 * r.n_s);
         os << "\n\n";
       }
     os.close();
     const bool svg = plot.size() > 4 && plot.substr(plot.size() - 4) == ".svg";
     std::string script = fmt::format(
         "set terminal {} size 900,600\nset output '{}'\nset logscale xy\nset xlabel 'CPU time "
-        "[s]'\nset ylabel 'E(T)'\nset key outside right\nset grid\nplot ",
+        "[s]'\nset ylabel 'E(T)'\nset format y '%.0e'\nset key outside right noenhanced\n"
+        "set grid\nset title 'OCP (61): terminal error vs CPU time (marker size: n_s)' "
+        "noenhanced\nplot ",
         svg ? "svg" : "pngcairo", plot);
     int idx = 0;
     for (bool f : {false, true})
-      for (fesd::RkScheme sc : schemes)
-        script += fmt::format("{}'{}' index {} with points pt {} title '{} {}'", idx ? ", " : "",
-                              data, idx, f ? 7 : 6, fesd::to_string(sc), f ? "FESD" : "std"),
+      for (fesd::RkScheme sc : plotted)
+        script += fmt::format(
+            "{}'{}' index {} using 1:2:3 with points pt {} ps variable title "
+            "'{} {}'",
+            idx ? ", " : "", data, idx, f ? 7 : 6, fesd::to_string(sc), f ? "FESD" : "std"),
             ++idx;
     script += "\n";
     const std::string sp = plot + ".gp";
