@@ -236,6 +236,7 @@ IntegratorResult integrate(const Pss& model, const Eigen::VectorXd& x0_in, doubl
   std::vector<double> failed_w;  // last iterate of a failed step, reported with the failure
   const discretization::FesdInterval* failed_iv = nullptr;
 
+  bool careful = false;  // an attempt of the current step failed (see solve_step)
   // Solves one step of level (k, r) from x; on success appends it to res and advances t, x,
   // guess.
   auto solve_step = [&](int k, int r) -> bool {
@@ -251,10 +252,30 @@ IntegratorResult integrate(const Pss& model, const Eigen::VectorXd& x0_in, doubl
     if (!nlp.finalized()) nlp.finalize();
     nlp::Iterate it;
     it.x = nlp.x_init;
-    mpcc::HomotopyResult hr = mpcc::solve_homotopy(nlp, *sn.relaxation, iv.residual_pairs(), solver,
-                                                   it, options.homotopy);
+    // Once an attempt of this step has failed, every retry solves all its NLPs to ipopt.tol:
+    // loosely solved early NLPs (intermediate_tol) can lead the homotopy astray in hard steps,
+    // e.g. one starting on the co-dimension-2 sliding set of OCP (61) (docs/formulation.md).
+    HomotopyOptions hopt = options.homotopy;
+    if (careful) hopt.intermediate_tol = 0;
+    mpcc::HomotopyResult hr =
+        mpcc::solve_homotopy(nlp, *sn.relaxation, iv.residual_pairs(), solver, it, hopt);
     std::vector<HomotopyRow> rows = hr.rows;
     account(hr);
+    auto restart = [&] {
+      it.x = nlp.x_init;
+      it.z_L.clear();
+      it.z_U.clear();
+      it.lambda.clear();
+    };
+    if (hr.status != Status::Success && hopt.intermediate_tol > 0) {  // same NLP, tight
+      careful = true;
+      hopt.intermediate_tol = 0;
+      restart();
+      hr = mpcc::solve_homotopy(nlp, *sn.relaxation, iv.residual_pairs(), solver, it, hopt);
+      account(hr);
+      rows.insert(rows.end(), hr.rows.begin(), hr.rows.end());
+    }
+    if (hr.status != Status::Success) careful = true;
     if (hr.status != Status::Success && can_fall_back) {  // same start, sparse form (28)
       if (!level.fallback) {
         DiscretizationOptions sparse = level_options(r);
@@ -267,12 +288,8 @@ IntegratorResult integrate(const Pss& model, const Eigen::VectorXd& x0_in, doubl
       fb.nlp.x_ub = nlp.x_ub;
       fb.nlp.x_init = nlp.x_init;
       if (!fb.nlp.finalized()) fb.nlp.finalize();
-      it.x = nlp.x_init;
-      it.z_L.clear();
-      it.z_U.clear();
-      it.lambda.clear();
-      hr = mpcc::solve_homotopy(fb.nlp, *fb.relaxation, fb.iv->residual_pairs(), solver, it,
-                                options.homotopy);
+      restart();
+      hr = mpcc::solve_homotopy(fb.nlp, *fb.relaxation, fb.iv->residual_pairs(), solver, it, hopt);
       account(hr);
       rows.insert(rows.end(), hr.rows.begin(), hr.rows.end());
       ++res.summary.fallback_steps;
@@ -313,6 +330,7 @@ IntegratorResult integrate(const Pss& model, const Eigen::VectorXd& x0_in, doubl
   res.status = Status::Success;
   res.message = "";
   for (int step = 0; step < N_sim; ++step) {
+    careful = false;
     const bool ok = advance(0);
     if (options.progress)
       std::fprintf(stderr, "  step %4d/%d  t = %-10.6g  NLPs %2zu  iter %4d  comp %.1e  %s\n",
