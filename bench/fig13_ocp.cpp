@@ -22,6 +22,7 @@
 #include <ctime>
 #include <fstream>
 #include <limits>
+#include <stdexcept>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -95,17 +96,20 @@ std::vector<Run> read_runs(const std::vector<std::string>& files) {
     while (std::getline(is, line)) {
       const std::vector<std::string> f = fesd_bench::split(line, ',');
       Run r;
-      if (f.size() != 10 || !fesd::parse(f[0], r.scheme))
+      try {
+        if (f.size() != 10 || !fesd::parse(f[0], r.scheme)) throw std::invalid_argument(line);
+        r.n_s = std::stoi(f[1]);
+        r.N_FE = std::stoi(f[2]);
+        r.fesd = f[3] == "1";
+        r.E = std::stod(f[4]);  // "nan" for a failed reference simulation
+        r.cpu_s = std::stod(f[5]);
+        r.iterations = std::stoi(f[6]);
+        r.nlps = std::stoi(f[7]);
+        r.objective = std::stod(f[8]);
+        r.status = f[9];
+      } catch (const std::exception&) {
         fesd_bench::usage(file + ": not a fig13_ocp CSV line: " + line, 1);
-      r.n_s = std::stoi(f[1]);
-      r.N_FE = std::stoi(f[2]);
-      r.fesd = f[3] == "1";
-      r.E = std::strtod(f[4].c_str(), nullptr);
-      r.cpu_s = std::strtod(f[5].c_str(), nullptr);
-      r.iterations = std::stoi(f[6]);
-      r.nlps = std::stoi(f[7]);
-      r.objective = std::strtod(f[8].c_str(), nullptr);
-      r.status = f[9];
+      }
       auto same = [&](const Run& o) {
         return o.scheme == r.scheme && o.n_s == r.n_s && o.N_FE == r.N_FE && o.fesd == r.fesd;
       };
@@ -161,8 +165,9 @@ int main(int argc, char** argv) {
     } else if (a == "--step-eq") {
       const std::string v = value();
       if (!fesd::parse(v, step_eq)) fesd_bench::usage("--step-eq " + v + ": unknown name");
-    } else if (a == "--intermediate-tol") {
-      intermediate_tol = fesd_bench::parse_double(a, value());
+    } else if (a == "--intermediate-tol") {  // 0 allowed: every NLP to tol
+      const std::string v = value();
+      intermediate_tol = v == "0" ? 0.0 : fesd_bench::parse_double(a, v);
     } else if (a == "--comp-tol") {
       comp_tol = fesd_bench::parse_double(a, value());
     } else if (a == "--mpcc-fesd" || a == "--mpcc-std") {
