@@ -6,8 +6,9 @@
 namespace fesd::mpcc {
 
 namespace {
-// NLPs with sigma <= this factor times complementarity_tol are solved with the configured tol.
-constexpr double kTightSigmaFactor = 10.0;
+// NLPs with sigma <= this factor times complementarity_tol are solved with the configured tol
+// (with a margin for the round-off of sigma_k = slope^k sigma_0: 0.1^8 is 1.0000000000000005e-8).
+constexpr double kTightSigmaFactor = 10.0 * (1.0 + 1e-9);
 }  // namespace
 
 double comp_residual(const double* x, const std::vector<CompPair>& pairs) {

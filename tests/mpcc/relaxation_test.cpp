@@ -81,6 +81,92 @@ TEST_P(TinyMpcc, ReachesTheLocalMinimizerOfTheStart) {
 }
 INSTANTIATE_TEST_SUITE_P(Modes, TinyMpcc, ::testing::ValuesIn(kAllModes), mode_name);
 
+// ---- intermediate_tol ---------------------------------------------------------------------
+
+/// IPOPT, recording the tolerance the homotopy asks for in each NLP (0: the configured one).
+class RecordingSolver : public fesd::nlp::NlpSolver {
+ public:
+  fesd::nlp::NlpResult solve(const fesd::nlp::BlockNlp& nlp, fesd::nlp::Iterate& start,
+                             bool warm_start, double tol) override {
+    tols.push_back(tol);
+    return inner_.solve(nlp, start, warm_start, tol);
+  }
+  std::vector<double> tols;
+
+ private:
+  fesd::nlp::IpoptSolver inner_{fesd::NlpOptions{}};
+};
+
+/// (x - 1)^2 + (y - a)^2
+struct DistanceTo {
+  double a = 1.0;
+  int num_inputs() const { return 2; }
+  int num_outputs() const { return 1; }
+  template <class T>
+  void operator()(const T* w, T* c) const {
+    c[0] = (w[0] - 1.0) * (w[0] - 1.0) + (w[1] - a) * (w[1] - a);
+  }
+};
+
+struct TinyProblem {
+  fesd::nlp::BlockNlp nlp;
+  int x = 0, y = 0;
+  std::vector<fesd::mpcc::CompPair> pairs;
+  std::unique_ptr<fesd::mpcc::Relaxation> relaxation;
+  explicit TinyProblem(double a) {
+    x = nlp.add_variables(1, 0.0, fesd::nlp::kInf, 0.9);
+    y = nlp.add_variables(1, 0.0, fesd::nlp::kInf, 0.2);
+    nlp.add_objective(fesd::nlp::make_block(DistanceTo{a}), {x, y});
+    pairs = {{x, y}};
+    relaxation = std::make_unique<fesd::mpcc::Relaxation>(
+        nlp, std::vector<fesd::mpcc::CompGroup>{fesd::mpcc::CompGroup{pairs}},
+        MpccMode::ScholtesIneq);
+    nlp.finalize();
+  }
+};
+
+// sigma = 0.1, 0.01, ..., 1e-9 with complementarity_tol 1e-9: the NLPs with sigma > 1e-8 get
+// intermediate_tol, the last two the configured tol; the solution is the same as with tight NLPs.
+TEST(IntermediateTol, EarlyNlpsLooseLastNlpsTight) {
+  TinyProblem p(1.0);
+  RecordingSolver solver;
+  fesd::nlp::Iterate it;
+  it.x = p.nlp.x_init;
+  fesd::HomotopyOptions options;
+  options.sigma_0 = 0.1;
+  options.intermediate_tol = 1e-6;
+  const auto res = fesd::mpcc::solve_homotopy(p.nlp, *p.relaxation, p.pairs, solver, it, options);
+  ASSERT_EQ(res.status, fesd::Status::Success) << res.last_nlp_status;
+  ASSERT_EQ(solver.tols.size(), 9u);  // sigma = 1e-1 .. 1e-9
+  for (std::size_t k = 0; k < 7; ++k) EXPECT_EQ(solver.tols[k], 1e-6) << "NLP " << k;
+  EXPECT_EQ(solver.tols[7], 0.0);
+  EXPECT_EQ(solver.tols[8], 0.0);
+  EXPECT_NEAR(it.x[p.x], 1.0, 1e-6);
+  EXPECT_NEAR(it.x[p.y], 0.0, 1e-6);
+}
+
+// min (x - 1)^2 + (y + 1)^2, 0 <= x _|_ y >= 0: the solution (1, 0) has no active product, so the
+// first (loose) NLP already meets complementarity_tol. It is solved once more, tight, at the same
+// sigma, and the homotopy stops.
+TEST(IntermediateTol, ToleranceMetLooselyIsSolvedAgainTight) {
+  TinyProblem p(-1.0);
+  RecordingSolver solver;
+  fesd::nlp::Iterate it;
+  it.x = p.nlp.x_init;
+  fesd::HomotopyOptions options;
+  options.sigma_0 = 0.1;
+  options.intermediate_tol = 1e-6;
+  const auto res = fesd::mpcc::solve_homotopy(p.nlp, *p.relaxation, p.pairs, solver, it, options);
+  ASSERT_EQ(res.status, fesd::Status::Success) << res.last_nlp_status;
+  ASSERT_EQ(solver.tols.size(), 2u);
+  EXPECT_EQ(solver.tols[0], 1e-6);
+  EXPECT_EQ(solver.tols[1], 0.0);
+  ASSERT_EQ(res.rows.size(), 2u);
+  EXPECT_EQ(res.rows[0].sigma, res.rows[1].sigma);
+  EXPECT_NEAR(it.x[p.x], 1.0, 1e-8);
+  EXPECT_NEAR(it.x[p.y], 0.0, 1e-8);
+}
+
 // ---- Example 3(a) through the integrator ------------------------------------------------------
 
 // x' in 2 - sign(x): c = x, region 0 (x > 0) gives 1, region 1 (x < 0) gives 3.
