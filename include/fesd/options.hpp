@@ -108,8 +108,8 @@ struct HomotopyOptions {
   /// `intermediate_tol` >= 0: IPOPT tol of the NLPs with sigma > 10 complementarity_tol (they
   /// only have to be good starting points for the next NLP); the later NLPs, and one that
   /// already meets complementarity_tol, are solved to ipopt.tol. 0: ipopt.tol for every NLP.
-  /// Measured (docs/benchmarks-ocp.md): OCP (61) 371 -> 251 IPOPT iterations, the README
-  /// oscillator 6783 -> 3603, same objective / an error of the same size (~1e-9).
+  /// Measured (docs/benchmarks-ocp.md): OCP (61) 371 -> 256 IPOPT iterations, the README
+  /// oscillator 6783 -> 3945, same objective / an error of the same size (1.5e-9 -> 1.1e-9).
   double intermediate_tol = 1e-6;
 };
 
