@@ -40,4 +40,8 @@ void write_csv(const OcpResult& result, const Pss& model, const std::string& pat
 void write_plot(const OcpResult& result, const Pss& model, const std::string& path,
                 const std::string& title = "");
 
+/// Throws fesd::IoError if gnuplot, which write_plot runs, is not on PATH: lets a front end fail
+/// before a long solve instead of after it. write_plot checks this itself.
+void require_gnuplot();
+
 }  // namespace fesd

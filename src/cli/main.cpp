@@ -9,7 +9,6 @@
 //
 // Exit codes: 0 solved, 1 numerical failure (outputs are still written), 2 bad input, 3 I/O
 // failure, 4 internal error. Every error is one line on stderr: "fesd: error: <message>".
-#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -213,24 +212,6 @@ std::string lower_extension(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
   for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
   return ext;
-}
-
-bool gnuplot_on_path() {
-  const char* env = std::getenv("PATH");
-  std::string_view dirs = env != nullptr ? env : "/usr/local/bin:/usr/bin:/bin";
-  while (true) {
-    const std::size_t colon = dirs.find(':');
-    std::string candidate(dirs.substr(0, colon));
-    if (candidate.empty()) candidate.push_back('.');
-    candidate += "/gnuplot";
-    struct stat st {};
-    if (::stat(candidate.c_str(), &st) == 0 && S_ISREG(st.st_mode) &&
-        ::access(candidate.c_str(), X_OK) == 0) {
-      return true;
-    }
-    if (colon == std::string_view::npos) return false;
-    dirs.remove_prefix(colon + 1);
-  }
 }
 
 /// Fails before a possibly long solve if an output file cannot be created (nothing is written).
@@ -440,9 +421,7 @@ void check_outputs(const SolveArgs& args, const CLI::App& cmd) {
           " (supported: .png, .svg)");
     }
     check_output_path("--plot", args.plot);
-    if (!gnuplot_on_path()) {
-      throw fesd::IoError("gnuplot not found: install gnuplot-nox (scripts/install-deps.sh)");
-    }
+    fesd::require_gnuplot();
   }
   if (cmd.count("--json") > 0) check_output_path("--json", args.json);
   if (cmd.count("--csv") > 0) check_output_path("--csv", args.csv);

@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "fesd/error.hpp"
+#include "fesd/io.hpp"
 
 extern char** environ;
 
@@ -226,7 +227,7 @@ std::string terminal_for(const std::string& path, int width, int height) {
 }
 
 void run_plot_script(const std::string& path, const std::string& script) {
-  if (!on_path("gnuplot")) throw IoError(std::string(kMissingGnuplot));
+  require_gnuplot();
 
   // Open the file ourselves first: a clear message if it cannot be written, and gnuplot never
   // falls back to writing the image to its standard output.
@@ -258,3 +259,11 @@ void run_plot_script(const std::string& path, const std::string& script) {
 }
 
 }  // namespace fesd::io_detail
+
+namespace fesd {
+
+void require_gnuplot() {
+  if (!io_detail::on_path("gnuplot")) throw IoError(std::string(io_detail::kMissingGnuplot));
+}
+
+}  // namespace fesd
