@@ -32,13 +32,14 @@ std::string mode_name(const ::testing::TestParamInfo<MpccMode>& p) {
 
 // ---- a two-variable MPCC ---------------------------------------------------------------------
 
-/// (x - 1)^2 + (y - 1)^2
-struct DistanceToOnes {
+/// (x - 1)^2 + (y - a)^2
+struct DistanceTo {
+  double a = 1.0;
   int num_inputs() const { return 2; }
   int num_outputs() const { return 1; }
   template <class T>
   void operator()(const T* w, T* c) const {
-    c[0] = (w[0] - 1.0) * (w[0] - 1.0) + (w[1] - 1.0) * (w[1] - 1.0);
+    c[0] = (w[0] - 1.0) * (w[0] - 1.0) + (w[1] - a) * (w[1] - a);
   }
 };
 
@@ -49,7 +50,7 @@ TEST_P(TinyMpcc, ReachesTheLocalMinimizerOfTheStart) {
   fesd::nlp::BlockNlp nlp;
   const int x = nlp.add_variables(1, 0.0, fesd::nlp::kInf, 0.9);
   const int y = nlp.add_variables(1, 0.0, fesd::nlp::kInf, 0.2);
-  nlp.add_objective(fesd::nlp::make_block(DistanceToOnes{}), {x, y});
+  nlp.add_objective(fesd::nlp::make_block(DistanceTo{1.0}), {x, y});
   const std::vector<fesd::mpcc::CompPair> pairs{{x, y}};
   const std::vector<fesd::mpcc::CompGroup> groups{fesd::mpcc::CompGroup{pairs}};
   const fesd::mpcc::Relaxation relaxation(nlp, groups, GetParam());
@@ -97,17 +98,6 @@ class RecordingSolver : public fesd::nlp::NlpSolver {
   fesd::nlp::IpoptSolver inner_{fesd::NlpOptions{}};
 };
 
-/// (x - 1)^2 + (y - a)^2
-struct DistanceTo {
-  double a = 1.0;
-  int num_inputs() const { return 2; }
-  int num_outputs() const { return 1; }
-  template <class T>
-  void operator()(const T* w, T* c) const {
-    c[0] = (w[0] - 1.0) * (w[0] - 1.0) + (w[1] - a) * (w[1] - a);
-  }
-};
-
 struct TinyProblem {
   fesd::nlp::BlockNlp nlp;
   int x = 0, y = 0;
@@ -123,6 +113,15 @@ struct TinyProblem {
         MpccMode::ScholtesIneq);
     nlp.finalize();
   }
+  /// The homotopy sigma = 0.1, 0.01, ... with intermediate_tol 1e-6, from (0.9, 0.2).
+  fesd::mpcc::HomotopyResult solve(RecordingSolver& solver) {
+    it.x = nlp.x_init;
+    fesd::HomotopyOptions options;
+    options.sigma_0 = 0.1;
+    options.intermediate_tol = 1e-6;
+    return fesd::mpcc::solve_homotopy(nlp, *relaxation, pairs, solver, it, options);
+  }
+  fesd::nlp::Iterate it;
 };
 
 // sigma = 0.1, 0.01, ..., 1e-9 with complementarity_tol 1e-9: the NLPs with sigma > 1e-8 get
@@ -130,19 +129,14 @@ struct TinyProblem {
 TEST(IntermediateTol, EarlyNlpsLooseLastNlpsTight) {
   TinyProblem p(1.0);
   RecordingSolver solver;
-  fesd::nlp::Iterate it;
-  it.x = p.nlp.x_init;
-  fesd::HomotopyOptions options;
-  options.sigma_0 = 0.1;
-  options.intermediate_tol = 1e-6;
-  const auto res = fesd::mpcc::solve_homotopy(p.nlp, *p.relaxation, p.pairs, solver, it, options);
+  const auto res = p.solve(solver);
   ASSERT_EQ(res.status, fesd::Status::Success) << res.last_nlp_status;
   ASSERT_EQ(solver.tols.size(), 9u);  // sigma = 1e-1 .. 1e-9
   for (std::size_t k = 0; k < 7; ++k) EXPECT_EQ(solver.tols[k], 1e-6) << "NLP " << k;
   EXPECT_EQ(solver.tols[7], 0.0);
   EXPECT_EQ(solver.tols[8], 0.0);
-  EXPECT_NEAR(it.x[p.x], 1.0, 1e-6);
-  EXPECT_NEAR(it.x[p.y], 0.0, 1e-6);
+  EXPECT_NEAR(p.it.x[p.x], 1.0, 1e-6);
+  EXPECT_NEAR(p.it.x[p.y], 0.0, 1e-6);
 }
 
 // min (x - 1)^2 + (y + 1)^2, 0 <= x _|_ y >= 0: the solution (1, 0) has no active product, so the
@@ -151,20 +145,15 @@ TEST(IntermediateTol, EarlyNlpsLooseLastNlpsTight) {
 TEST(IntermediateTol, ToleranceMetLooselyIsSolvedAgainTight) {
   TinyProblem p(-1.0);
   RecordingSolver solver;
-  fesd::nlp::Iterate it;
-  it.x = p.nlp.x_init;
-  fesd::HomotopyOptions options;
-  options.sigma_0 = 0.1;
-  options.intermediate_tol = 1e-6;
-  const auto res = fesd::mpcc::solve_homotopy(p.nlp, *p.relaxation, p.pairs, solver, it, options);
+  const auto res = p.solve(solver);
   ASSERT_EQ(res.status, fesd::Status::Success) << res.last_nlp_status;
   ASSERT_EQ(solver.tols.size(), 2u);
   EXPECT_EQ(solver.tols[0], 1e-6);
   EXPECT_EQ(solver.tols[1], 0.0);
   ASSERT_EQ(res.rows.size(), 2u);
   EXPECT_EQ(res.rows[0].sigma, res.rows[1].sigma);
-  EXPECT_NEAR(it.x[p.x], 1.0, 1e-8);
-  EXPECT_NEAR(it.x[p.y], 0.0, 1e-8);
+  EXPECT_NEAR(p.it.x[p.x], 1.0, 1e-8);
+  EXPECT_NEAR(p.it.x[p.y], 0.0, 1e-8);
 }
 
 // ---- Example 3(a) through the integrator ------------------------------------------------------
