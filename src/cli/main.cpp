@@ -470,8 +470,11 @@ int finish(const Result& result, const std::string& report, const fesd::Pss& mod
   return fesd::exit_code(result.status);
 }
 
-int run_simulate(const SolveArgs& args, const CLI::App& cmd) {
-  fesd::SimulationProblem problem = load<fesd::SimulationProblem>(args.file, args.overrides);
+/// Loads the problem file with the overrides, checks the output paths (before a possibly long
+/// solve), prints the header unless --quiet, and turns progress lines on unless --quiet.
+template <class Problem>
+Problem prepare(const SolveArgs& args, const CLI::App& cmd) {
+  Problem problem = load<Problem>(args.file, args.overrides);
   check_outputs(args, cmd);
   if (!args.quiet) {
     print_header(problem);
@@ -479,6 +482,11 @@ int run_simulate(const SolveArgs& args, const CLI::App& cmd) {
     std::fflush(stdout);
   }
   problem.options.progress = !args.quiet;
+  return problem;
+}
+
+int run_simulate(const SolveArgs& args, const CLI::App& cmd) {
+  const auto problem = prepare<fesd::SimulationProblem>(args, cmd);
   const fesd::IntegratorResult result =
       fesd::integrate(problem.model, problem.x0, problem.T_sim, problem.N_sim, problem.options,
                       problem.u, problem.p);
@@ -486,14 +494,7 @@ int run_simulate(const SolveArgs& args, const CLI::App& cmd) {
 }
 
 int run_solve(const SolveArgs& args, const CLI::App& cmd) {
-  fesd::OcpProblem problem = load<fesd::OcpProblem>(args.file, args.overrides);
-  check_outputs(args, cmd);
-  if (!args.quiet) {
-    print_header(problem);
-    fmt::print("\n");
-    std::fflush(stdout);
-  }
-  problem.options.progress = !args.quiet;
+  const auto problem = prepare<fesd::OcpProblem>(args, cmd);
   const fesd::OcpResult result = fesd::solve(problem.ocp, problem.options);
   return finish(result, result.report(), problem.ocp.model, problem.name, args, cmd,
                 "optimal control problem");
