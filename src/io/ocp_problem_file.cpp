@@ -387,9 +387,7 @@ void apply_override(OcpProblem& problem, std::string_view key_in, std::string_vi
   const std::string& head = arg.head;
 
   OcpProblem updated = problem;
-  const OptionSpec<Op>* spec = nullptr;
-  for (const OptionSpec<Op>& o : kOptions)
-    if (o.key == key && (table.empty() || o.table == table)) spec = &o;
+  const OptionSpec<Op>* spec = find_option(kOptions, table, key);
 
   if (spec != nullptr) {
     spec->set(updated, override_value(spec->kind, value, head));

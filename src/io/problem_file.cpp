@@ -162,9 +162,7 @@ void apply_override(SimulationProblem& problem, std::string_view key_in,
   const std::string& head = arg.head;
 
   SimulationProblem updated = problem;
-  const OptionSpec<Sp>* spec = nullptr;
-  for (const OptionSpec<Sp>& o : kOptions)
-    if (o.key == key && (table.empty() || o.table == table)) spec = &o;
+  const OptionSpec<Sp>* spec = find_option(kOptions, table, key);
 
   if (spec != nullptr) {
     spec->set(updated, override_value(spec->kind, value, head));

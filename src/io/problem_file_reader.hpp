@@ -319,6 +319,17 @@ std::vector<std::string_view> keys_of_table(const std::array<OptionSpec<Problem>
   return keys;
 }
 
+/// The option `key` of `table` (of any table if `table` is empty; the last match), or nullptr:
+/// the lookup of a command-line override.
+template <class Problem, std::size_t K>
+const OptionSpec<Problem>* find_option(const std::array<OptionSpec<Problem>, K>& specs,
+                                       std::string_view table, std::string_view key) {
+  const OptionSpec<Problem>* spec = nullptr;
+  for (const OptionSpec<Problem>& o : specs)
+    if (o.key == key && (table.empty() || o.table == table)) spec = &o;
+  return spec;
+}
+
 /// Parses an enum option name; on failure returns "unknown name (expected one of ...)".
 std::optional<std::string> parse_enum(Kind kind, std::string_view name, OptionValue& v);
 
