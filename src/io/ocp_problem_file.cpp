@@ -211,13 +211,7 @@ void read_options(const Reader& r, const toml::table& root, OcpProblem& problem)
       else
         o.set(problem, read_option(r, o.table, o.key, o.kind, *n));
     }
-    if (table_name == "ipopt") {
-      for (const auto& [k, v] : in_file_order(t)) {
-        if (std::find(keys.begin(), keys.end(), k->str()) != keys.end()) continue;
-        problem.options.nlp.extra.emplace_back(k->str(),
-                                               ipopt_value(r, *v, join("ipopt", k->str())));
-      }
-    }
+    if (table_name == "ipopt") read_ipopt_extra(r, t, keys, problem.options.nlp.extra);
   }
   const std::vector<std::string> errors = validate_all(problem);
   if (!errors.empty()) throw_validation_errors(r, root, errors);

@@ -585,6 +585,15 @@ OptionValue read_option(const Reader& r, std::string_view table, std::string_vie
   return v;
 }
 
+void read_ipopt_extra(const Reader& r, const toml::table& t,
+                      const std::vector<std::string_view>& keys,
+                      std::vector<std::pair<std::string, std::string>>& extra) {
+  for (const auto& [k, v] : in_file_order(t)) {
+    if (std::find(keys.begin(), keys.end(), k->str()) != keys.end()) continue;
+    extra.emplace_back(k->str(), ipopt_value(r, *v, join("ipopt", k->str())));
+  }
+}
+
 std::string ipopt_value(const Reader& r, const toml::node& n, std::string_view path) {
   if (const auto* s = n.as_string()) return s->get();
   if (const auto* i = n.as_integer()) return fmt::format("{}", i->get());

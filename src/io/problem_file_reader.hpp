@@ -339,6 +339,11 @@ OptionValue read_option(const Reader& r, std::string_view table, std::string_vie
 
 /// An [ipopt] value as IPOPT's option string (numbers shortest exact, booleans yes/no).
 std::string ipopt_value(const Reader& r, const toml::node& n, std::string_view path);
+/// Appends every key of the [ipopt] table `t` that is not one of fesd's own `keys` to `extra`, in
+/// file order, as (name, IPOPT value string).
+void read_ipopt_extra(const Reader& r, const toml::table& t,
+                      const std::vector<std::string_view>& keys,
+                      std::vector<std::pair<std::string, std::string>>& extra);
 
 /// The "table.key" a validate() message starts with ("discretization.n_s = 0: ...").
 std::string_view message_key(std::string_view message);
