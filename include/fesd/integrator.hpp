@@ -60,6 +60,12 @@ struct Summary {
   /// at most twice: quarter steps). Each half step has N_FE elements of its own, so the grid then
   /// has more than N_sim * N_FE elements.
   int split_steps = 0;
+  /// Sliding exits pinned (DiscretizationOptions::pin_sliding_exits): exits at an element
+  /// boundary where the leaving region's theta was still > 1e-6, each moved to where it reaches
+  /// 0 by solving the step's last NLP once more (its row follows in `homotopy`).
+  int pinned_exits = 0;
+  /// Steps whose pinned re-solve failed; they keep the unpinned solution.
+  int pin_failures = 0;
 };
 
 /// The result of integrate(). Time grid = all finite-element boundaries t_0 < ... < t_{N_sim N_FE}

@@ -142,6 +142,11 @@ struct OcpResult {
   std::vector<Eigen::VectorXd> theta, lambda;
 
   std::vector<HomotopyRow> homotopy;  ///< one row per NLP
+  /// Sliding exits pinned after the homotopy (DiscretizationOptions::pin_sliding_exits): the
+  /// last NLP was solved once more (the last row of `homotopy`). pin_failed: that solve failed
+  /// and the result is the unpinned solution.
+  int pinned_exits = 0;
+  bool pin_failed = false;
   int nlp_iterations = 0;
   int n_variables = 0, n_constraints = 0;
   double wall_s = 0, derivative_s = 0, solver_s = 0, setup_s = 0;

@@ -116,6 +116,8 @@ constexpr OverrideKey kOverrideKeys[] = {
      "where lambda >= 0 holds: all (stages), boundary (element ends) or auto", Scope::Both},
     {"gamma_h", "--gamma_h", "step size freedom in (0, 1]", Scope::Both},
     {"rho_h", "--rho_h", "weight of the heuristic_mean penalty", Scope::Both},
+    {"pin_sliding_exits", "--pin_sliding_exits",
+     "1: solve once more with sliding exits pinned where theta has not reached 0", Scope::Both},
     {"mpcc_mode", "--mpcc_mode",
      "scholtes_ineq, scholtes_eq, fischer_burmeister, ell_1_penalty or elastic_ineq", Scope::Both},
     {"sigma_0", "--sigma_0", "first homotopy relaxation", Scope::Both},

@@ -469,6 +469,34 @@ std::vector<int> FesdInterval::active_set(const double* w, int n) const {
   return active;
 }
 
+std::vector<int> FesdInterval::exit_regions(const Pss& model, const std::vector<int>& before,
+                                            const std::vector<int>& after) {
+  auto has = [](const std::vector<int>& v, int r) {
+    return std::find(v.begin(), v.end(), r) != v.end();
+  };
+  std::vector<int> exits;
+  for (int k = 0; k < model.n_sys(); ++k) {
+    const int first = model.region_offset(k), last = model.region_offset(k + 1);
+    bool stays = false;
+    for (int r = first; r < last; ++r) stays = stays || (has(before, r) && has(after, r));
+    if (!stays) continue;
+    for (int r = first; r < last; ++r)
+      if (has(before, r) && !has(after, r)) exits.push_back(r);
+  }
+  return exits;
+}
+
+void FesdInterval::pin_exit(nlp::BlockNlp& nlp, std::vector<double>& w, int n, int r) const {
+  if (!can_pin_exits())
+    throw Error("internal: FesdInterval::pin_exit needs FESD, stiffly accurate");
+  for (int s = 0; s < n_s_; ++s) {
+    const int l = lambda(n, s, r);
+    nlp.x_lb[l] = nlp.x_ub[l] = w[l] = 0.0;
+  }
+  const int th = theta(n, n_s_ - 1, r);
+  nlp.x_ub[th] = w[th] = 0.0;
+}
+
 void FesdInterval::update_lifted_guess(nlp::BlockNlp& nlp) const {
   auto& w = nlp.x_init;
   for (std::size_t n = 0; n < lam_sum_.size(); ++n)

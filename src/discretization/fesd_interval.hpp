@@ -100,6 +100,31 @@ class FesdInterval {
   /// switching boundary). Integrator and OCP report switches where this set changes.
   std::vector<int> active_set(const double* w, int n) const;
   static constexpr double kActiveThetaTol = 1e-6;
+
+  // ---- sliding exits (docs/formulation.md, "Leaving a sliding mode") ----
+  // Where a sliding mode ends, the theta of the region that is left falls to 0 continuously. The
+  // FESD equations do not say so: an exit at an element boundary up to O(h) before the exact one
+  // satisfies them too (lambda >= 0 at the next stage points holds, the state leaving the
+  // surface quadratically), and the step penalties then choose where. Pinning the exit
+  // (theta of the leaving region = 0 at the element end, the element kept on the surface)
+  // removes that freedom.
+
+  /// Regions whose sliding mode ends between two consecutive elements with active sets `before`
+  /// and `after` (active_set()): per subsystem, the regions active before and not after, where
+  /// another region of the subsystem is active on both sides (a crossing has none in common).
+  static std::vector<int> exit_regions(const Pss& model, const std::vector<int>& before,
+                                       const std::vector<int>& after);
+  /// Exits can be pinned: FESD with a stiffly accurate scheme (theta at t_{n+1} is a variable).
+  bool can_pin_exits() const { return opt_.use_fesd && stiffly_accurate_; }
+  /// Pins a sliding exit of region r at the end of element n by the variable bounds:
+  /// lambda_{n,m,r} = 0 at every stage (element n stays on the surface) and theta_{n,n_s,r} = 0
+  /// (the region's weight reaches 0 at t_{n+1}). Sets the same values in w.
+  void pin_exit(nlp::BlockNlp& nlp, std::vector<double>& w, int n, int r) const;
+  /// Between two integration steps an exit is pinned only when theta of the leaving region at
+  /// the end of the step before exceeds this (below it the exit is early by ~ theta / |d theta /
+  /// dt|, an error ~1e-12 in the state); else the first element would have to slide on without
+  /// the region and shrink to length 0.
+  static constexpr double kExitThetaTol = 1e-6;
   /// Recomputes the lifted sums of step equilibration (if any) from the other entries of
   /// nlp.x_init; call after changing the guess of lambda or theta.
   void update_lifted_guess(nlp::BlockNlp& nlp) const;

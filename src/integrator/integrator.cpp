@@ -236,6 +236,48 @@ IntegratorResult integrate(const Pss& model, const Eigen::VectorXd& x0_in, doubl
   std::vector<double> failed_w;  // last iterate of a failed step, reported with the failure
   const discretization::FesdInterval* failed_iv = nullptr;
 
+  // Sliding exits of a solved step (docs/formulation.md): every exit between its elements, and an
+  // exit at its start where the previous step ended with theta > kExitThetaTol of the leaving
+  // region, is pinned, and the last NLP solved again; if that fails, the unpinned solution
+  // stays. Bounds are restored for the next step.
+  auto pin_exits = [&](StepNlp& sn, nlp::Iterate& it, double sigma, int k,
+                       std::vector<HomotopyRow>& rows) {
+    const discretization::FesdInterval& iv = *sn.iv;
+    const std::vector<double>& w = it.x;
+    std::vector<std::pair<int, int>> pins;  // (element, region)
+    std::vector<int> before = res.active_set.empty() ? std::vector<int>{} : res.active_set.back();
+    for (int n = 0; n < iv.N_FE(); ++n) {
+      const std::vector<int> after = iv.active_set(w.data(), n);
+      for (int r : discretization::FesdInterval::exit_regions(model, before, after)) {
+        if (n > 0) {
+          pins.emplace_back(n - 1, r);
+        } else if (guess.theta[r] > discretization::FesdInterval::kExitThetaTol) {
+          // The previous step ended sliding with theta_r > 0 (guess.theta: its last stage), and
+          // this one starts without r: an early exit at the step start. Element 0 is pinned: it
+          // stays on the surface until theta_r reaches 0.
+          pins.emplace_back(0, r);
+        }
+      }
+      before = after;
+    }
+    if (pins.empty()) return;
+    const std::vector<double> lb = sn.nlp.x_lb, ub = sn.nlp.x_ub;
+    const nlp::Iterate unpinned = it;
+    for (const auto& [n, r] : pins) iv.pin_exit(sn.nlp, it.x, n, r);
+    const mpcc::HomotopyResult again = mpcc::solve_again(
+        sn.nlp, *sn.relaxation, iv.residual_pairs(), solver, it, sigma, k, options.homotopy);
+    account(again);
+    rows.insert(rows.end(), again.rows.begin(), again.rows.end());
+    sn.nlp.x_lb = lb;
+    sn.nlp.x_ub = ub;
+    if (again.status == Status::Success) {
+      res.summary.pinned_exits += static_cast<int>(pins.size());
+    } else {
+      it = unpinned;
+      ++res.summary.pin_failures;
+    }
+  };
+
   bool careful = false;  // an attempt of the current step failed (see solve_step)
   // Solves one step of level (k, r) from x; on success appends it to res and advances t, x,
   // guess.
@@ -276,6 +318,7 @@ IntegratorResult integrate(const Pss& model, const Eigen::VectorXd& x0_in, doubl
       rows.insert(rows.end(), hr.rows.begin(), hr.rows.end());
     }
     if (hr.status != Status::Success) careful = true;
+    StepNlp* solved = &sn;                                // the NLP whose solution `it` is
     if (hr.status != Status::Success && can_fall_back) {  // same start, sparse form (28)
       if (!level.fallback) {
         DiscretizationOptions sparse = level_options(r);
@@ -293,7 +336,10 @@ IntegratorResult integrate(const Pss& model, const Eigen::VectorXd& x0_in, doubl
       account(hr);
       rows.insert(rows.end(), hr.rows.begin(), hr.rows.end());
       ++res.summary.fallback_steps;
+      solved = &fb;
     }
+    if (hr.status == Status::Success && d.pin_sliding_exits && iv.can_pin_exits())
+      pin_exits(*solved, it, hr.rows.back().sigma, static_cast<int>(rows.size()), rows);
     res.homotopy.push_back(std::move(rows));
     last_hr = hr;
     const std::vector<double>& w = it.x;
@@ -401,6 +447,9 @@ std::string IntegratorResult::full_report() const {
   if (summary.split_steps > 0)
     os << fmt::format("  split steps          {}  (retried as two half steps)\n",
                       summary.split_steps);
+  if (summary.pinned_exits > 0 || summary.pin_failures > 0)
+    os << fmt::format("  pinned sliding exits {}  ({} re-solves failed, unpinned)\n",
+                      summary.pinned_exits, summary.pin_failures);
   os << fmt::format("  wall time            {:.3f} s  ({:.2f} ms per step)\n", summary.wall_s,
                     1e3 * summary.wall_s / steps);
   const double busy = summary.derivative_s + summary.solver_s;

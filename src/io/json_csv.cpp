@@ -54,7 +54,9 @@ json stats(const Summary& s) {
               {"max_comp_residual", number(s.max_comp_residual)},
               {"fallback_steps", s.fallback_steps},
               {"refined_steps", s.refined_steps},
-              {"split_steps", s.split_steps}};
+              {"split_steps", s.split_steps},
+              {"pinned_exits", s.pinned_exits},
+              {"pin_failures", s.pin_failures}};
 }
 
 json switches(const std::vector<SwitchEvent>& events) {
@@ -276,7 +278,9 @@ void write_json(const OcpResult& result, const Pss& model, const std::string& pa
                     {"n_variables", result.n_variables},
                     {"n_constraints", result.n_constraints},
                     {"comp_residual", number(result.comp_residual)},
-                    {"mpcc_mode", std::string(to_string(result.mpcc_mode))}};
+                    {"mpcc_mode", std::string(to_string(result.mpcc_mode))},
+                    {"pinned_exits", result.pinned_exits},
+                    {"pin_failed", result.pin_failed}};
   j["t_stage"] = array(result.t_stage);
   j["x_stage"] = rows(result.x_stage);
   j["theta"] = rows(result.theta);

@@ -251,7 +251,7 @@ struct OptionSpec {
 /// The options of [discretization], [homotopy] and [ipopt], for every problem type whose
 /// `options` has members discretization, homotopy and nlp.
 template <class Problem>
-constexpr std::array<OptionSpec<Problem>, 20> solver_option_specs() {
+constexpr std::array<OptionSpec<Problem>, 21> solver_option_specs() {
   using P = Problem;
   using V = OptionValue;
   return {{
@@ -273,6 +273,8 @@ constexpr std::array<OptionSpec<Problem>, 20> solver_option_specs() {
        [](P& q, const V& v) { q.options.discretization.gamma_h = v.d; }},
       {"discretization", "rho_h", Kind::Double,
        [](P& q, const V& v) { q.options.discretization.rho_h = v.d; }},
+      {"discretization", "pin_sliding_exits", Kind::Bool,
+       [](P& q, const V& v) { q.options.discretization.pin_sliding_exits = v.b; }},
       {"homotopy", "mpcc_mode", Kind::Mpcc,
        [](P& q, const V& v) { q.options.homotopy.mpcc_mode = v.mpcc; }},
       {"homotopy", "sigma_0", Kind::Double,

@@ -9,6 +9,7 @@
 #include <limits>
 #include <memory>
 #include <sstream>
+#include <tuple>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -487,6 +488,25 @@ void extract(const OcpNlp& b, const Ocp& ocp, const std::vector<double>& w,
   res.objective = objective;
 }
 
+/// The sliding exits to pin (DiscretizationOptions::pin_sliding_exits) at the solution w:
+/// (interval, element, region) of every element end inside a control interval where a sliding
+/// mode ends. Not at control-interval boundaries: there the control jumps, and with it the
+/// sliding vector field, so a mode may end there with theta > 0.
+std::vector<std::tuple<int, int, int>> exits_to_pin(const OcpNlp& b, const Pss& m,
+                                                    const std::vector<double>& w) {
+  std::vector<std::tuple<int, int, int>> pins;
+  for (int k = 0; k < static_cast<int>(b.iv.size()); ++k) {
+    const FesdInterval& iv = *b.iv[k];
+    std::vector<int> before = iv.active_set(w.data(), 0);
+    for (int n = 1; n < iv.N_FE(); ++n) {
+      std::vector<int> after = iv.active_set(w.data(), n);
+      for (int r : FesdInterval::exit_regions(m, before, after)) pins.emplace_back(k, n - 1, r);
+      before = std::move(after);
+    }
+  }
+  return pins;
+}
+
 }  // namespace
 
 std::vector<std::string> validate(const OcpOptions& o) {
@@ -529,14 +549,39 @@ OcpResult solve(const Ocp& ocp, const OcpOptions& options) {
                    r.comp_residual, r.objective, r.inf_pr, r.nlp_iterations, r.nlp_status.c_str(),
                    r.cpu_s);
   };
-  const mpcc::HomotopyResult hr = mpcc::solve_homotopy(b->nlp, relaxation, b->residual_pairs,
-                                                       solver, it, options.homotopy, on_row);
-  res.status = hr.status;
+  mpcc::HomotopyResult hr = mpcc::solve_homotopy(b->nlp, relaxation, b->residual_pairs, solver, it,
+                                                 options.homotopy, on_row);
   res.homotopy = hr.rows;
-  res.comp_residual = hr.comp_residual;
   res.nlp_iterations = hr.nlp_iterations;
   res.derivative_s = hr.eval_s;
   res.solver_s = hr.solver_s;
+  // Sliding exits left early (docs/formulation.md): pin them and solve the last NLP once more;
+  // if that fails, the unpinned solution stays.
+  if (hr.status == Status::Success && options.discretization.pin_sliding_exits &&
+      b->iv.front()->can_pin_exits()) {
+    const auto pins = exits_to_pin(*b, ocp.model, it.x);
+    if (!pins.empty()) {
+      const nlp::Iterate unpinned = it;
+      for (const auto& [k, n, r] : pins) b->iv[k]->pin_exit(b->nlp, it.x, n, r);
+      const mpcc::HomotopyResult again =
+          mpcc::solve_again(b->nlp, relaxation, b->residual_pairs, solver, it, hr.rows.back().sigma,
+                            static_cast<int>(hr.rows.size()), options.homotopy);
+      on_row(again.rows.back());
+      res.homotopy.push_back(again.rows.back());
+      res.nlp_iterations += again.nlp_iterations;
+      res.derivative_s += again.eval_s;
+      res.solver_s += again.solver_s;
+      if (again.status == Status::Success) {
+        res.pinned_exits = static_cast<int>(pins.size());
+        hr.comp_residual = again.comp_residual;
+      } else {
+        it = unpinned;
+        res.pin_failed = true;
+      }
+    }
+  }
+  res.status = hr.status;
+  res.comp_residual = hr.comp_residual;
   extract(*b, ocp, it.x, p, res);
   res.message = res.status == Status::Success
                     ? std::string(describe(Status::Success))
@@ -570,6 +615,11 @@ std::string OcpResult::report() const {
                     n_constraints);
   os << fmt::format("  homotopy             {} NLPs, {} IPOPT iterations\n", homotopy.size(),
                     nlp_iterations);
+  if (pinned_exits > 0 || pin_failed)
+    os << fmt::format("  sliding exits        {}\n",
+                      pin_failed
+                          ? "pinning failed (unpinned solution kept)"
+                          : fmt::format("{} pinned (last row: the pinned NLP)", pinned_exits));
   os << fmt::format("    {:>3} {:>9} {:>10} {:>14} {:>9} {:>5}  {:<26} {:>8}\n", "k", "sigma",
                     "comp", "objective", "inf_pr", "iter", "IPOPT status", "time s");
   for (const auto& r : homotopy)

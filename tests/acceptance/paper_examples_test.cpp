@@ -135,6 +135,46 @@ TEST(LeavingSliding, LeavesAtOneThenParabola) {
   EXPECT_NEAR(r.x_final()[1], T, 1e-12);
 }
 
+// Example 3(c) on grids where the FESD equations alone let the integrator leave the sliding mode
+// early: an exit at an element boundary t_e - dt with theta of the leaving region still ~dt / 2
+// satisfies them (the state leaves the surface quadratically, so lambda >= 0 holds at the next
+// stage points), and the step penalty prefers it. Without pinning, measured: exit early by
+// 5e-2 (Radau IIA n_s = 2, T = 2.5, N_sim = 4), 4.2e-3 (n_s = 3, T = 2.1, N_sim = 4), 0.17
+// (Lobatto IIIC n_s = 2, T = 2.5, N_sim = 3), x(T) wrong by dt^2 / 2. With the exit pinned
+// (pin_sliding_exits, the default): exit time and x(T) to 7e-9 and 1.6e-8. Tolerance 5e-8.
+struct ExitCase {
+  RkScheme scheme;
+  int n_s;
+  double T;
+  int N_sim;
+};
+class PinnedExitTest : public ::testing::TestWithParam<ExitCase> {};
+TEST_P(PinnedExitTest, LeavesAtOneExactly) {
+  const ExitCase c = GetParam();
+  Eigen::VectorXd x0(2);
+  x0 << 0.0, 0.0;
+  IntegratorOptions o = options(c.scheme, c.n_s);
+  const auto r = fesd::integrate(sign_model(0, 1, true), x0, c.T, c.N_sim, o);
+  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+  EXPECT_GE(r.summary.pinned_exits, 1);
+  EXPECT_EQ(r.summary.pin_failures, 0);
+  ASSERT_GE(r.switches.size(), 1u);
+  EXPECT_NEAR(r.switches.back().t, 1.0, 5e-8);
+  EXPECT_NEAR(r.x_final()[0], (c.T - 1) * (c.T - 1) / 2, 5e-8);
+
+  // The same grid without pinning leaves early (what the option is for).
+  o.discretization.pin_sliding_exits = false;
+  const auto u = fesd::integrate(sign_model(0, 1, true), x0, c.T, c.N_sim, o);
+  ASSERT_EQ(u.status, fesd::Status::Success) << u.message;
+  ASSERT_GE(u.switches.size(), 1u);
+  EXPECT_LT(u.switches.back().t, 1.0 - 1e-3);
+  EXPECT_EQ(u.summary.pinned_exits, 0);
+}
+INSTANTIATE_TEST_SUITE_P(Example3c, PinnedExitTest,
+                         ::testing::Values(ExitCase{RkScheme::RadauIIA, 2, 2.5, 4},
+                                           ExitCase{RkScheme::RadauIIA, 3, 2.1, 4},
+                                           ExitCase{RkScheme::LobattoIIIC, 2, 2.5, 3}));
+
 // Example 3(d), x' in sign(x), x(0) = 0: infinitely many solutions (stay at 0 up to any t*, then
 // |x| = t - t*). fesd returns one valid solution; check that it is one of them.
 TEST(Spontaneous, ReturnsOneValidSolution) {

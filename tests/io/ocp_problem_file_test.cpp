@@ -67,6 +67,7 @@ void expect_same_options(const OcpOptions& a, const OcpOptions& b) {
   EXPECT_EQ(d.stage_lambda_sign, e.stage_lambda_sign);
   EXPECT_EQ(d.gamma_h, e.gamma_h);
   EXPECT_EQ(d.rho_h, e.rho_h);
+  EXPECT_EQ(d.pin_sliding_exits, e.pin_sliding_exits);
   EXPECT_EQ(a.homotopy.mpcc_mode, b.homotopy.mpcc_mode);
   EXPECT_EQ(a.homotopy.sigma_0, b.homotopy.sigma_0);
   EXPECT_EQ(a.homotopy.homotopy_update_slope, b.homotopy.homotopy_update_slope);

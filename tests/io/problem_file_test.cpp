@@ -240,6 +240,7 @@ TEST(ProblemFile, DefaultsWhenTablesAreAbsent) {
   EXPECT_EQ(o.discretization.step_eq, def.discretization.step_eq);
   EXPECT_EQ(o.discretization.gamma_h, def.discretization.gamma_h);
   EXPECT_EQ(o.discretization.rho_h, def.discretization.rho_h);
+  EXPECT_EQ(o.discretization.pin_sliding_exits, def.discretization.pin_sliding_exits);
   EXPECT_EQ(o.homotopy.sigma_0, def.homotopy.sigma_0);
   EXPECT_EQ(o.homotopy.homotopy_update_slope, def.homotopy.homotopy_update_slope);
   EXPECT_EQ(o.homotopy.sigma_N, def.homotopy.sigma_N);
@@ -274,6 +275,7 @@ cross_comp_mode = "neighbor"
 step_equilibration = "eta_tanh"
 gamma_h = 0.5
 rho_h = 10
+pin_sliding_exits = false
 [homotopy]
 sigma_0 = 2.0
 homotopy_update_slope = 0.2
@@ -308,6 +310,7 @@ max_soc = 2
   EXPECT_EQ(d.step_eq, StepEq::EtaTanh);
   EXPECT_EQ(d.gamma_h, 0.5);
   EXPECT_EQ(d.rho_h, 10.0);
+  EXPECT_FALSE(d.pin_sliding_exits);
   const HomotopyOptions& h = q.options.homotopy;
   EXPECT_EQ(h.sigma_0, 2.0);
   EXPECT_EQ(h.homotopy_update_slope, 0.2);
