@@ -116,6 +116,13 @@ class FesdInterval {
                                        const std::vector<int>& after);
   /// Exits can be pinned: FESD with a stiffly accurate scheme (theta at t_{n+1} is a variable).
   bool can_pin_exits() const { return opt_.use_fesd && stiffly_accurate_; }
+  /// The sliding exits inside the interval at the NLP point w, as (element n, region r) for
+  /// pin_exit(): every exit between elements n and n+1 (exit_regions of their active sets); and
+  /// an exit inside the last element (r active there together with another region of its
+  /// subsystem, but at its end theta_r <= kExitThetaTol and lambda_r > kExitLambdaTol: the state
+  /// left the surface inside the element, which cross complementarity tolerates because both
+  /// factors are small there), pinned in the element before if that one slides on r too.
+  std::vector<std::pair<int, int>> exits_to_pin(const double* w) const;
   /// Pins a sliding exit of region r at the end of element n by the variable bounds:
   /// lambda_{n,m,r} = 0 at every stage (element n stays on the surface) and theta_{n,n_s,r} = 0
   /// (the region's weight reaches 0 at t_{n+1}). Sets the same values in w.
@@ -125,6 +132,7 @@ class FesdInterval {
   /// dt|, an error ~1e-12 in the state); else the first element would have to slide on without
   /// the region and shrink to length 0.
   static constexpr double kExitThetaTol = 1e-6;
+  static constexpr double kExitLambdaTol = 1e-6;
   /// Recomputes the lifted sums of step equilibration (if any) from the other entries of
   /// nlp.x_init; call after changing the guess of lambda or theta.
   void update_lifted_guess(nlp::BlockNlp& nlp) const;

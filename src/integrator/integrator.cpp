@@ -244,21 +244,16 @@ IntegratorResult integrate(const Pss& model, const Eigen::VectorXd& x0_in, doubl
                        std::vector<HomotopyRow>& rows) {
     const discretization::FesdInterval& iv = *sn.iv;
     const std::vector<double>& w = it.x;
-    std::vector<std::pair<int, int>> pins;  // (element, region)
-    std::vector<int> before = res.active_set.empty() ? std::vector<int>{} : res.active_set.back();
-    for (int n = 0; n < iv.N_FE(); ++n) {
-      const std::vector<int> after = iv.active_set(w.data(), n);
-      for (int r : discretization::FesdInterval::exit_regions(model, before, after)) {
-        if (n > 0) {
-          pins.emplace_back(n - 1, r);
-        } else if (guess.theta[r] > discretization::FesdInterval::kExitThetaTol) {
+    std::vector<std::pair<int, int>> pins = iv.exits_to_pin(w.data());  // (element, region)
+    if (!res.active_set.empty()) {
+      const std::vector<int> first = iv.active_set(w.data(), 0);
+      for (int r : discretization::FesdInterval::exit_regions(model, res.active_set.back(), first))
+        if (guess.theta[r] > discretization::FesdInterval::kExitThetaTol) {
           // The previous step ended sliding with theta_r > 0 (guess.theta: its last stage), and
           // this one starts without r: an early exit at the step start. Element 0 is pinned: it
           // stays on the surface until theta_r reaches 0.
           pins.emplace_back(0, r);
         }
-      }
-      before = after;
     }
     if (pins.empty()) return;
     const std::vector<double> lb = sn.nlp.x_lb, ub = sn.nlp.x_ub;

@@ -488,25 +488,6 @@ void extract(const OcpNlp& b, const Ocp& ocp, const std::vector<double>& w,
   res.objective = objective;
 }
 
-/// The sliding exits to pin (DiscretizationOptions::pin_sliding_exits) at the solution w:
-/// (interval, element, region) of every element end inside a control interval where a sliding
-/// mode ends. Not at control-interval boundaries: there the control jumps, and with it the
-/// sliding vector field, so a mode may end there with theta > 0.
-std::vector<std::tuple<int, int, int>> exits_to_pin(const OcpNlp& b, const Pss& m,
-                                                    const std::vector<double>& w) {
-  std::vector<std::tuple<int, int, int>> pins;
-  for (int k = 0; k < static_cast<int>(b.iv.size()); ++k) {
-    const FesdInterval& iv = *b.iv[k];
-    std::vector<int> before = iv.active_set(w.data(), 0);
-    for (int n = 1; n < iv.N_FE(); ++n) {
-      std::vector<int> after = iv.active_set(w.data(), n);
-      for (int r : FesdInterval::exit_regions(m, before, after)) pins.emplace_back(k, n - 1, r);
-      before = std::move(after);
-    }
-  }
-  return pins;
-}
-
 }  // namespace
 
 std::vector<std::string> validate(const OcpOptions& o) {
@@ -559,7 +540,11 @@ OcpResult solve(const Ocp& ocp, const OcpOptions& options) {
   // if that fails, the unpinned solution stays.
   if (hr.status == Status::Success && options.discretization.pin_sliding_exits &&
       b->iv.front()->can_pin_exits()) {
-    const auto pins = exits_to_pin(*b, ocp.model, it.x);
+    // Inside control intervals only: at their boundaries the control jumps, and with it the
+    // sliding vector field, so a mode may end there with theta > 0.
+    std::vector<std::tuple<int, int, int>> pins;
+    for (int k = 0; k < ocp.N_stages; ++k)
+      for (const auto& [n, r] : b->iv[k]->exits_to_pin(it.x.data())) pins.emplace_back(k, n, r);
     if (!pins.empty()) {
       const nlp::Iterate unpinned = it;
       for (const auto& [k, n, r] : pins) b->iv[k]->pin_exit(b->nlp, it.x, n, r);
