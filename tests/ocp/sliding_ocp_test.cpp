@@ -33,6 +33,12 @@ TEST(SlidingModeOcp, SwitchingSequenceOfSection53AndPiecewiseUniformGrid) {
   EXPECT_EQ(r.switches[0].before, expected[0]);
   for (std::size_t i = 0; i < 4; ++i) EXPECT_EQ(r.switches[i].after, expected[i + 1]) << i;
   for (std::size_t i = 1; i < 4; ++i) EXPECT_GT(r.switches[i].t, r.switches[i - 1].t);
+  // The exit from the co-dimension-2 set lies inside control interval 3: pinned (theta of the
+  // region left = 0 at the element end) and solved once more. The exit from phi_1 = 0 is on the
+  // control-interval boundary t = 8/3, where exits are not pinned.
+  EXPECT_EQ(r.pinned_exits, 1);
+  EXPECT_FALSE(r.pin_failed);
+  EXPECT_NEAR(r.switches[3].t, 8.0 / 3.0, 1e-9);
   // Step equilibration: inside a control interval h changes only where the active set does
   // (Fig. 12, middle). Tolerance 1e-6 of h0 = 1/9: the NLP is solved to 1e-12 but the penalty
   // balances h only to its optimality tolerance.
