@@ -132,7 +132,9 @@ class FesdInterval {
   /// dt|, an error ~1e-12 in the state); else the first element would have to slide on without
   /// the region and shrink to length 0.
   static constexpr double kExitThetaTol = 1e-6;
-  static constexpr double kExitLambdaTol = 1e-6;
+  /// lambda at the end of an element above which the state has left the surface (the state
+  /// error is about this size); the NLP's own noise in lambda is ~1e-10.
+  static constexpr double kExitLambdaTol = 1e-9;
   /// Recomputes the lifted sums of step equilibration (if any) from the other entries of
   /// nlp.x_init; call after changing the guess of lambda or theta.
   void update_lifted_guess(nlp::BlockNlp& nlp) const;
