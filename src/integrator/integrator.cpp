@@ -236,10 +236,10 @@ IntegratorResult integrate(const Pss& model, const Eigen::VectorXd& x0_in, doubl
   std::vector<double> failed_w;  // last iterate of a failed step, reported with the failure
   const discretization::FesdInterval* failed_iv = nullptr;
 
-  // Sliding exits of a solved step (docs/formulation.md): every exit between its elements, and an
-  // exit at its start where the previous step ended with theta > kExitThetaTol of the leaving
-  // region, is pinned, and the last NLP solved again; if that fails, the unpinned solution
-  // stays. Bounds are restored for the next step.
+  // Sliding exits of a solved step (docs/formulation.md): the exits inside it
+  // (FesdInterval::exits_to_pin), and an exit at its start where the previous step ended with
+  // theta > kExitThetaTol of the leaving region, are pinned and the last NLP solved again; if
+  // that fails, the unpinned solution stays.
   auto pin_exits = [&](StepNlp& sn, nlp::Iterate& it, double sigma, int k,
                        std::vector<HomotopyRow>& rows) {
     const discretization::FesdInterval& iv = *sn.iv;
@@ -256,21 +256,17 @@ IntegratorResult integrate(const Pss& model, const Eigen::VectorXd& x0_in, doubl
         }
     }
     if (pins.empty()) return;
-    const std::vector<double> lb = sn.nlp.x_lb, ub = sn.nlp.x_ub;
-    const nlp::Iterate unpinned = it;
-    for (const auto& [n, r] : pins) iv.pin_exit(sn.nlp, it.x, n, r);
     const mpcc::HomotopyResult again = mpcc::solve_again(
-        sn.nlp, *sn.relaxation, iv.residual_pairs(), solver, it, sigma, k, options.homotopy);
+        sn.nlp, *sn.relaxation, iv.residual_pairs(), solver, it, sigma, k, options.homotopy,
+        [&](nlp::BlockNlp& problem, std::vector<double>& point) {
+          for (const auto& [n, r] : pins) iv.pin_exit(problem, point, n, r);
+        });
     account(again);
     rows.insert(rows.end(), again.rows.begin(), again.rows.end());
-    sn.nlp.x_lb = lb;
-    sn.nlp.x_ub = ub;
-    if (again.status == Status::Success) {
+    if (again.status == Status::Success)
       res.summary.pinned_exits += static_cast<int>(pins.size());
-    } else {
-      it = unpinned;
+    else
       ++res.summary.pin_failures;
-    }
   };
 
   bool careful = false;  // an attempt of the current step failed (see solve_step)

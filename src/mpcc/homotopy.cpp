@@ -86,15 +86,22 @@ HomotopyResult solve_homotopy(nlp::BlockNlp& nlp, const Relaxation& relaxation,
   return res;
 }
 
-HomotopyResult solve_again(nlp::BlockNlp& nlp, const Relaxation& relaxation,
-                           const std::vector<CompPair>& residual_pairs, nlp::NlpSolver& solver,
-                           nlp::Iterate& it, double sigma, int k, const HomotopyOptions& o) {
+HomotopyResult solve_again(
+    nlp::BlockNlp& nlp, const Relaxation& relaxation, const std::vector<CompPair>& residual_pairs,
+    nlp::NlpSolver& solver, nlp::Iterate& it, double sigma, int k, const HomotopyOptions& o,
+    const std::function<void(nlp::BlockNlp&, std::vector<double>&)>& change) {
   HomotopyResult res;
-  apply_sigma(relaxation, nlp, it, sigma);
-  const nlp::NlpResult r = solver.solve(nlp, it, /*warm_start=*/true, 0.0);
-  res.comp_residual = comp_residual(it.x.data(), residual_pairs);
+  const std::vector<double> x_lb = nlp.x_lb, x_ub = nlp.x_ub;
+  nlp::Iterate trial = it;
+  change(nlp, trial.x);
+  apply_sigma(relaxation, nlp, trial, sigma);
+  const nlp::NlpResult r = solver.solve(nlp, trial, /*warm_start=*/true, 0.0);
+  nlp.x_lb = x_lb;
+  nlp.x_ub = x_ub;
+  res.comp_residual = comp_residual(trial.x.data(), residual_pairs);
   record(res, r, k, sigma);
   res.status = final_status(r.success, r.eval_error, res.comp_residual, o.complementarity_tol);
+  if (res.status == Status::Success) it = std::move(trial);
   return res;
 }
 

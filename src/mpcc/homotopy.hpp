@@ -44,11 +44,13 @@ HomotopyResult solve_homotopy(nlp::BlockNlp& nlp, const Relaxation& relaxation,
                               const std::function<void(const HomotopyRow&)>& on_row = {});
 
 /// Solves the last NLP of a homotopy once more (the same sigma, the configured tolerance, warm
-/// start from `it`) after the caller changed variable bounds, e.g. pinned a sliding exit. One
-/// row, numbered k; Success when it converges with a complementarity residual <=
-/// complementarity_tol. `it` holds the new point, whatever the status.
+/// start from `it`) with the variable bounds and start point changed by `change` (e.g. sliding
+/// exits pinned), then restores the bounds. One row, numbered k; Success when it converges with
+/// a complementarity residual <= complementarity_tol. On Success `it` holds the new solution,
+/// otherwise it is left as it was.
 HomotopyResult solve_again(nlp::BlockNlp& nlp, const Relaxation& relaxation,
                            const std::vector<CompPair>& residual_pairs, nlp::NlpSolver& solver,
-                           nlp::Iterate& it, double sigma, int k, const HomotopyOptions& options);
+                           nlp::Iterate& it, double sigma, int k, const HomotopyOptions& options,
+                           const std::function<void(nlp::BlockNlp&, std::vector<double>&)>& change);
 
 }  // namespace fesd::mpcc

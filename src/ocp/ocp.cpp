@@ -546,11 +546,13 @@ OcpResult solve(const Ocp& ocp, const OcpOptions& options) {
     for (int k = 0; k < ocp.N_stages; ++k)
       for (const auto& [n, r] : b->iv[k]->exits_to_pin(it.x.data())) pins.emplace_back(k, n, r);
     if (!pins.empty()) {
-      const nlp::Iterate unpinned = it;
-      for (const auto& [k, n, r] : pins) b->iv[k]->pin_exit(b->nlp, it.x, n, r);
       const mpcc::HomotopyResult again =
           mpcc::solve_again(b->nlp, relaxation, b->residual_pairs, solver, it, hr.rows.back().sigma,
-                            static_cast<int>(hr.rows.size()), options.homotopy);
+                            static_cast<int>(hr.rows.size()), options.homotopy,
+                            [&](nlp::BlockNlp& problem, std::vector<double>& point) {
+                              for (const auto& [k, n, r] : pins)
+                                b->iv[k]->pin_exit(problem, point, n, r);
+                            });
       on_row(again.rows.back());
       res.homotopy.push_back(again.rows.back());
       res.nlp_iterations += again.nlp_iterations;
@@ -560,7 +562,6 @@ OcpResult solve(const Ocp& ocp, const OcpOptions& options) {
         res.pinned_exits = static_cast<int>(pins.size());
         hr.comp_residual = again.comp_residual;
       } else {
-        it = unpinned;
         res.pin_failed = true;
       }
     }
