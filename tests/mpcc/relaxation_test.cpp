@@ -156,6 +156,49 @@ TEST(IntermediateTol, ToleranceMetLooselyIsSolvedAgainTight) {
   EXPECT_NEAR(p.it.x[p.y], 0.0, 1e-8);
 }
 
+// ---- solve_again (pinned sliding exits) --------------------------------------------------------
+
+// After the homotopy (solution (1, 0)): bounds changed by the callback for one more NLP at the
+// last sigma, then restored. A feasible change gives its solution; an infeasible one (x = 2 and
+// y >= 1, so x y >= 2 > sigma) leaves the point as it was.
+TEST(SolveAgain, ChangesBoundsForOneNlpAndKeepsThePointIfItFails) {
+  TinyProblem p(1.0);
+  RecordingSolver solver;
+  const auto res = p.solve(solver);
+  ASSERT_EQ(res.status, fesd::Status::Success) << res.last_nlp_status;
+  const double sigma = res.rows.back().sigma;
+  const std::vector<double> lb = p.nlp.x_lb, ub = p.nlp.x_ub;
+  fesd::HomotopyOptions options;
+
+  const auto capped = fesd::mpcc::solve_again(
+      p.nlp, *p.relaxation, p.pairs, solver, p.it, sigma, 9, options,
+      [&](fesd::nlp::BlockNlp& nlp, std::vector<double>& x) {
+        nlp.x_ub[p.x] = 0.5;
+        x[p.x] = 0.5;
+      });
+  ASSERT_EQ(capped.status, fesd::Status::Success) << capped.last_nlp_status;
+  ASSERT_EQ(capped.rows.size(), 1u);
+  EXPECT_EQ(capped.rows[0].k, 9);
+  EXPECT_EQ(capped.rows[0].sigma, sigma);
+  EXPECT_EQ(solver.tols.back(), 0.0);  // the configured tolerance
+  EXPECT_NEAR(p.it.x[p.x], 0.5, 1e-8);
+  EXPECT_NEAR(p.it.x[p.y], 0.0, 1e-8);
+  EXPECT_EQ(p.nlp.x_lb, lb);
+  EXPECT_EQ(p.nlp.x_ub, ub);
+
+  const std::vector<double> before = p.it.x;
+  const auto infeasible = fesd::mpcc::solve_again(
+      p.nlp, *p.relaxation, p.pairs, solver, p.it, sigma, 10, options,
+      [&](fesd::nlp::BlockNlp& nlp, std::vector<double>&) {
+        nlp.x_lb[p.x] = nlp.x_ub[p.x] = 2.0;
+        nlp.x_lb[p.y] = 1.0;
+      });
+  EXPECT_NE(infeasible.status, fesd::Status::Success);
+  EXPECT_EQ(p.it.x, before);
+  EXPECT_EQ(p.nlp.x_lb, lb);
+  EXPECT_EQ(p.nlp.x_ub, ub);
+}
+
 // ---- Example 3(a) through the integrator ------------------------------------------------------
 
 // x' in 2 - sign(x): c = x, region 0 (x > 0) gives 1, region 1 (x < 0) gives 3.
