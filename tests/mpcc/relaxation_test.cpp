@@ -170,12 +170,12 @@ TEST(SolveAgain, ChangesBoundsForOneNlpAndKeepsThePointIfItFails) {
   const std::vector<double> lb = p.nlp.x_lb, ub = p.nlp.x_ub;
   fesd::HomotopyOptions options;
 
-  const auto capped = fesd::mpcc::solve_again(
-      p.nlp, *p.relaxation, p.pairs, solver, p.it, sigma, 9, options,
-      [&](fesd::nlp::BlockNlp& nlp, std::vector<double>& x) {
-        nlp.x_ub[p.x] = 0.5;
-        x[p.x] = 0.5;
-      });
+  const auto capped =
+      fesd::mpcc::solve_again(p.nlp, *p.relaxation, p.pairs, solver, p.it, sigma, 9, options,
+                              [&](fesd::nlp::BlockNlp& nlp, std::vector<double>& x) {
+                                nlp.x_ub[p.x] = 0.5;
+                                x[p.x] = 0.5;
+                              });
   ASSERT_EQ(capped.status, fesd::Status::Success) << capped.last_nlp_status;
   ASSERT_EQ(capped.rows.size(), 1u);
   EXPECT_EQ(capped.rows[0].k, 9);
@@ -187,12 +187,12 @@ TEST(SolveAgain, ChangesBoundsForOneNlpAndKeepsThePointIfItFails) {
   EXPECT_EQ(p.nlp.x_ub, ub);
 
   const std::vector<double> before = p.it.x;
-  const auto infeasible = fesd::mpcc::solve_again(
-      p.nlp, *p.relaxation, p.pairs, solver, p.it, sigma, 10, options,
-      [&](fesd::nlp::BlockNlp& nlp, std::vector<double>&) {
-        nlp.x_lb[p.x] = nlp.x_ub[p.x] = 2.0;
-        nlp.x_lb[p.y] = 1.0;
-      });
+  const auto infeasible =
+      fesd::mpcc::solve_again(p.nlp, *p.relaxation, p.pairs, solver, p.it, sigma, 10, options,
+                              [&](fesd::nlp::BlockNlp& nlp, std::vector<double>&) {
+                                nlp.x_lb[p.x] = nlp.x_ub[p.x] = 2.0;
+                                nlp.x_lb[p.y] = 1.0;
+                              });
   EXPECT_NE(infeasible.status, fesd::Status::Success);
   EXPECT_EQ(p.it.x, before);
   EXPECT_EQ(p.nlp.x_lb, lb);
