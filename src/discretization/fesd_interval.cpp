@@ -486,46 +486,50 @@ std::vector<int> FesdInterval::exit_regions(const Pss& model, const std::vector<
   return exits;
 }
 
-std::vector<std::pair<int, int>> FesdInterval::exits_to_pin(const double* w) const {
-  std::vector<std::pair<int, int>> pins;
+std::vector<FesdInterval::ExitPin> FesdInterval::exits_to_pin(const double* w,
+                                                              bool control_jump_at_end) const {
+  std::vector<ExitPin> pins;
   std::vector<std::vector<int>> active(N_FE_);
   for (int n = 0; n < N_FE_; ++n) active[n] = active_set(w, n);
   for (int n = 0; n + 1 < N_FE_; ++n)
-    for (int r : exit_regions(model_, active[n], active[n + 1])) pins.emplace_back(n, r);
-  // An exit inside the last element: r slides there and in the element before, and has left
-  // the surface by the end (its exit then counts as one from element N_FE - 2).
+    for (int r : exit_regions(model_, active[n], active[n + 1])) pins.push_back({n, r, true});
+  // An exit inside the last element: r slides there and has left the surface by its end.
   const int last = N_FE_ - 1;
-  if (last >= 1) {
-    auto has = [](const std::vector<int>& v, int r) {
-      return std::find(v.begin(), v.end(), r) != v.end();
+  auto has = [](const std::vector<int>& v, int r) {
+    return std::find(v.begin(), v.end(), r) != v.end();
+  };
+  for (int k = 0; k < model_.n_sys(); ++k) {
+    const int first = model_.region_offset(k), end = model_.region_offset(k + 1);
+    auto slides = [&](const std::vector<int>& a, int r) {
+      if (!has(a, r)) return false;
+      for (int j = first; j < end; ++j)
+        if (j != r && has(a, j)) return true;
+      return false;
     };
-    for (int k = 0; k < model_.n_sys(); ++k) {
-      const int first = model_.region_offset(k), end = model_.region_offset(k + 1);
-      auto slides = [&](const std::vector<int>& a, int r) {
-        if (!has(a, r)) return false;
-        for (int j = first; j < end; ++j)
-          if (j != r && has(a, j)) return true;
-        return false;
-      };
-      for (int r = first; r < end; ++r)
-        if (slides(active[last], r) && slides(active[last - 1], r) &&
-            w[theta(last, n_s_ - 1, r)] <= kExitThetaTol &&
-            w[lambda(last, n_s_ - 1, r)] > kExitLambdaTol)
-          pins.emplace_back(last - 1, r);
+    for (int r = first; r < end; ++r) {
+      if (!slides(active[last], r) || w[theta(last, n_s_ - 1, r)] > kExitThetaTol ||
+          w[lambda(last, n_s_ - 1, r)] <= kExitLambdaTol)
+        continue;
+      if (control_jump_at_end)
+        pins.push_back({last, r, false});
+      else if (last >= 1 && slides(active[last - 1], r))
+        pins.push_back({last - 1, r, true});
     }
   }
   return pins;
 }
 
-void FesdInterval::pin_exit(nlp::BlockNlp& nlp, std::vector<double>& w, int n, int r) const {
+void FesdInterval::pin_exit(nlp::BlockNlp& nlp, std::vector<double>& w, const ExitPin& pin) const {
   if (!can_pin_exits())
     throw Error("internal: FesdInterval::pin_exit needs FESD, stiffly accurate");
   for (int s = 0; s < n_s_; ++s) {
-    const int l = lambda(n, s, r);
+    const int l = lambda(pin.n, s, pin.r);
     nlp.x_lb[l] = nlp.x_ub[l] = w[l] = 0.0;
   }
-  const int th = theta(n, n_s_ - 1, r);
-  nlp.x_ub[th] = w[th] = 0.0;
+  if (pin.theta_zero) {
+    const int th = theta(pin.n, n_s_ - 1, pin.r);
+    nlp.x_ub[th] = w[th] = 0.0;
+  }
 }
 
 void FesdInterval::update_lifted_guess(nlp::BlockNlp& nlp) const {

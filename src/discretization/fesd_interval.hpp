@@ -116,17 +116,25 @@ class FesdInterval {
                                        const std::vector<int>& after);
   /// Exits can be pinned: FESD with a stiffly accurate scheme (theta at t_{n+1} is a variable).
   bool can_pin_exits() const { return opt_.use_fesd && stiffly_accurate_; }
-  /// The sliding exits inside the interval at the NLP point w, as (element n, region r) for
-  /// pin_exit(): every exit between elements n and n+1 (exit_regions of their active sets); and
-  /// an exit inside the last element (r active there together with another region of its
-  /// subsystem, but at its end theta_r <= kExitThetaTol and lambda_r > kExitLambdaTol: the state
-  /// left the surface inside the element, which cross complementarity tolerates because both
-  /// factors are small there), pinned in the element before if that one slides on r too.
-  std::vector<std::pair<int, int>> exits_to_pin(const double* w) const;
-  /// Pins a sliding exit of region r at the end of element n by the variable bounds:
-  /// lambda_{n,m,r} = 0 at every stage (element n stays on the surface) and theta_{n,n_s,r} = 0
-  /// (the region's weight reaches 0 at t_{n+1}). Sets the same values in w.
-  void pin_exit(nlp::BlockNlp& nlp, std::vector<double>& w, int n, int r) const;
+  /// A sliding exit to pin: region r leaves at the end of element n. theta_zero: its theta
+  /// reaches 0 there (false: the exit is made by a jump of the control at the interval end).
+  struct ExitPin {
+    int n = 0, r = 0;
+    bool theta_zero = true;
+  };
+  /// The sliding exits inside the interval at the NLP point w: every exit between elements n and
+  /// n+1 (exit_regions of their active sets), and an exit inside the last element (r active
+  /// there together with another region of its subsystem, but at its end theta_r <=
+  /// kExitThetaTol and lambda_r > kExitLambdaTol: the state left the surface inside the element,
+  /// which cross complementarity tolerates because both factors are small there). The latter is
+  /// pinned in the element before if that one slides on r too; or, with control_jump_at_end (an
+  /// OCP interval, whose control changes at its end), in the last element without theta_zero:
+  /// the mode is kept to the interval end, where the new control may end it.
+  std::vector<ExitPin> exits_to_pin(const double* w, bool control_jump_at_end) const;
+  /// Pins an exit by the variable bounds: lambda_{n,m,r} = 0 at every stage (element n stays on
+  /// the surface) and, with theta_zero, theta_{n,n_s,r} = 0 (the region's weight reaches 0 at
+  /// t_{n+1}). Sets the same values in w.
+  void pin_exit(nlp::BlockNlp& nlp, std::vector<double>& w, const ExitPin& pin) const;
   /// Between two integration steps an exit is pinned only when theta of the leaving region at
   /// the end of the step before exceeds this (below it the exit is early by ~ theta / |d theta /
   /// dt|, an error ~1e-12 in the state); else the first element would have to slide on without

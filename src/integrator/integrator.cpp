@@ -2,6 +2,7 @@
 // start state (fixed variables) and a shifted initial guess.
 #include "fesd/integrator.hpp"
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -244,22 +245,40 @@ IntegratorResult integrate(const Pss& model, const Eigen::VectorXd& x0_in, doubl
                        std::vector<HomotopyRow>& rows) {
     const discretization::FesdInterval& iv = *sn.iv;
     const std::vector<double>& w = it.x;
-    std::vector<std::pair<int, int>> pins = iv.exits_to_pin(w.data());  // (element, region)
+    std::vector<discretization::FesdInterval::ExitPin> pins =
+        iv.exits_to_pin(w.data(), /*control_jump_at_end=*/false);
+    // The previous step ended sliding with theta_r > 0 (guess.theta: its last stage), and this
+    // one starts without r: an early exit at the step start. Element 0 is pinned: it stays on
+    // the surface until theta_r reaches 0. Its length gets a lower bound, half the time theta_r
+    // takes to reach 0 at its rate in the previous element: a pinned element of length ~0 would
+    // meet theta_r = 0 only within the tolerance (the stage equations lose their hold on theta
+    // as h -> 0), without moving the exit.
+    double h0_min = 0;
     if (!res.active_set.empty()) {
       const std::vector<int> first = iv.active_set(w.data(), 0);
-      for (int r : discretization::FesdInterval::exit_regions(model, res.active_set.back(), first))
-        if (guess.theta[r] > discretization::FesdInterval::kExitThetaTol) {
-          // The previous step ended sliding with theta_r > 0 (guess.theta: its last stage), and
-          // this one starts without r: an early exit at the step start. Element 0 is pinned: it
-          // stays on the surface until theta_r reaches 0.
-          pins.emplace_back(0, r);
-        }
+      for (int r :
+           discretization::FesdInterval::exit_regions(model, res.active_set.back(), first)) {
+        const double th_end = guess.theta[r];
+        if (th_end <= discretization::FesdInterval::kExitThetaTol) continue;
+        // theta_r at the first and last stage of the previous element (res.theta, res.t_stage).
+        const std::size_t last = res.theta.size() - 1, first_stage = last + 1 - n_s;
+        const double dt = res.t_stage[last] - res.t_stage[first_stage];
+        const double rate = dt > 0 ? (th_end - res.theta[first_stage][r]) / dt : 0.0;
+        if (rate >= 0) continue;  // theta_r not falling: no exit to expect near the step start
+        pins.push_back({0, r, true});
+        h0_min = std::max(h0_min, 0.5 * th_end / -rate);
+      }
     }
     if (pins.empty()) return;
     const mpcc::HomotopyResult again = mpcc::solve_again(
         sn.nlp, *sn.relaxation, iv.residual_pairs(), solver, it, sigma, k, options.homotopy,
         [&](nlp::BlockNlp& problem, std::vector<double>& point) {
-          for (const auto& [n, r] : pins) iv.pin_exit(problem, point, n, r);
+          for (const auto& pin : pins) iv.pin_exit(problem, point, pin);
+          const int h0 = iv.h(0);
+          if (h0_min > 0 && h0_min < problem.x_ub[h0]) {
+            problem.x_lb[h0] = std::max(problem.x_lb[h0], h0_min);
+            point[h0] = std::max(point[h0], h0_min);
+          }
         });
     account(again);
     rows.insert(rows.end(), again.rows.begin(), again.rows.end());

@@ -9,7 +9,6 @@
 #include <limits>
 #include <memory>
 #include <sstream>
-#include <tuple>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -540,18 +539,20 @@ OcpResult solve(const Ocp& ocp, const OcpOptions& options) {
   // if that fails, the unpinned solution stays.
   if (hr.status == Status::Success && options.discretization.pin_sliding_exits &&
       b->iv.front()->can_pin_exits()) {
-    // Inside control intervals only: at their boundaries the control jumps, and with it the
-    // sliding vector field, so a mode may end there with theta > 0.
-    std::vector<std::tuple<int, int, int>> pins;
+    // Per control interval: at their boundaries the control jumps, and with it the sliding
+    // vector field, so a mode may end there with theta > 0; one that ends inside the last
+    // element of an interval is kept on the surface up to the boundary instead.
+    std::vector<std::pair<int, FesdInterval::ExitPin>> pins;  // (interval, pin)
     for (int k = 0; k < ocp.N_stages; ++k)
-      for (const auto& [n, r] : b->iv[k]->exits_to_pin(it.x.data())) pins.emplace_back(k, n, r);
+      for (const auto& pin : b->iv[k]->exits_to_pin(it.x.data(), /*control_jump_at_end=*/true))
+        pins.emplace_back(k, pin);
     if (!pins.empty()) {
       const mpcc::HomotopyResult again =
           mpcc::solve_again(b->nlp, relaxation, b->residual_pairs, solver, it, hr.rows.back().sigma,
                             static_cast<int>(hr.rows.size()), options.homotopy,
                             [&](nlp::BlockNlp& problem, std::vector<double>& point) {
-                              for (const auto& [k, n, r] : pins)
-                                b->iv[k]->pin_exit(problem, point, n, r);
+                              for (const auto& [k, pin] : pins)
+                                b->iv[k]->pin_exit(problem, point, pin);
                             });
       on_row(again.rows.back());
       res.homotopy.push_back(again.rows.back());
