@@ -63,6 +63,8 @@ nlohmann::json row_json(const std::string& name, const fesd::OcpResult& r) {
           {"derivative_s", r.derivative_s},
           {"solver_s", r.solver_s},
           {"n_variables", r.n_variables},
+          {"pinned_exits", r.pinned_exits},
+          {"pin_failed", r.pin_failed},
           {"switch_times", [&] {
              std::vector<double> t;
              for (const auto& e : r.switches) t.push_back(e.t);
@@ -70,15 +72,18 @@ nlohmann::json row_json(const std::string& name, const fesd::OcpResult& r) {
            }()}};
 }
 
+// pin: sliding exits pinned after the homotopy ("fail": the pinned NLP failed, unpinned kept).
 void print_row(const std::string& name, const fesd::OcpResult& r) {
-  fmt::print("{:<20} {:<22} {:>12.7f} {:>9.1e} {:>9.1e} {:>5} {:>6} {:>8.2f}  {}\n", name,
+  fmt::print("{:<20} {:<22} {:>12.7f} {:>9.1e} {:>9.1e} {:>5} {:>6} {:>8.2f} {:>4}  {}\n", name,
              fesd::to_string(r.status), r.objective, terminal_error(r), r.comp_residual,
-             r.homotopy.size(), r.nlp_iterations, r.wall_s, sequence(r));
+             r.homotopy.size(), r.nlp_iterations, r.wall_s,
+             r.pin_failed ? std::string("fail") : std::to_string(r.pinned_exits), sequence(r));
 }
 
 void print_head() {
-  fmt::print("{:<20} {:<22} {:>12} {:>9} {:>9} {:>5} {:>6} {:>8}  {}\n", "", "status", "objective",
-             "|q(4)-qf|", "comp", "NLPs", "iter", "time s", "switches t:{active regions after}");
+  fmt::print("{:<20} {:<22} {:>12} {:>9} {:>9} {:>5} {:>6} {:>8} {:>4}  {}\n", "", "status",
+             "objective", "|q(4)-qf|", "comp", "NLPs", "iter", "time s", "pin",
+             "switches t:{active regions after}");
 }
 
 }  // namespace

@@ -66,7 +66,7 @@ HomotopyResult solve_homotopy(nlp::BlockNlp& nlp, const Relaxation& relaxation,
     const bool loose = !tight_now && o.intermediate_tol > 0 &&
                        sigma > kTightSigmaFactor * o.complementarity_tol && sigma > o.sigma_N;
     const nlp::NlpResult r =
-        solver.solve(nlp, it, /*warm_start=*/k > 0, loose ? o.intermediate_tol : 0.0);
+        solver.solve(nlp, it, /*warm_start=*/k > 0, loose ? o.intermediate_tol : 0.0, 0);
     res.comp_residual = comp_residual(it.x.data(), residual_pairs);
     record(res, r, k, sigma);
     if (on_row) on_row(res.rows.back());
@@ -95,7 +95,7 @@ HomotopyResult solve_again(
   nlp::Iterate trial = it;
   change(nlp, trial.x);
   apply_sigma(relaxation, nlp, trial, sigma);
-  const nlp::NlpResult r = solver.solve(nlp, trial, /*warm_start=*/true, 0.0);
+  const nlp::NlpResult r = solver.solve(nlp, trial, /*warm_start=*/true, 0.0, kSolveAgainMaxIter);
   nlp.x_lb = x_lb;
   nlp.x_ub = x_ub;
   res.comp_residual = comp_residual(trial.x.data(), residual_pairs);

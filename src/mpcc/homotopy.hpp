@@ -43,8 +43,12 @@ HomotopyResult solve_homotopy(nlp::BlockNlp& nlp, const Relaxation& relaxation,
                               nlp::Iterate& it, const HomotopyOptions& options,
                               const std::function<void(const HomotopyRow&)>& on_row = {});
 
-/// Solves the last NLP of a homotopy once more (the same sigma, the configured tolerance, warm
-/// start from `it`) with the variable bounds and start point changed by `change` (e.g. sliding
+/// Iteration limit of solve_again: a warm-started re-solve with pinned exits converges in 10-30
+/// IPOPT iterations when it converges at all; failing ones ran into the configured 500.
+inline constexpr int kSolveAgainMaxIter = 100;
+
+/// Solves the last NLP of a homotopy once more (the same sigma, the configured tolerance, at most
+/// kSolveAgainMaxIter iterations, warm start from `it`) with the variable bounds and start point changed by `change` (e.g. sliding
 /// exits pinned), then restores the bounds. One row, numbered k; Success when it converges with
 /// a complementarity residual <= complementarity_tol. On Success `it` holds the new solution,
 /// otherwise it is left as it was.

@@ -226,6 +226,7 @@ struct IpoptSolver::Impl {
   Ipopt::SmartPtr<Ipopt::IpoptApplication> app;
   bool user_linear_solver = false;  // the caller chose IPOPT's linear_solver: never override it
   double tol = 0;                   // the configured tol (NlpOptions::tol or [ipopt] extra)
+  int max_iter = 0;                 // the configured max_iter
 };
 
 IpoptSolver::IpoptSolver(const NlpOptions& o) : impl_(std::make_unique<Impl>()) {
@@ -246,16 +247,20 @@ IpoptSolver::IpoptSolver(const NlpOptions& o) : impl_(std::make_unique<Impl>()) 
     if (name == "linear_solver") impl_->user_linear_solver = true;
   }
   app.Options()->GetNumericValue("tol", impl_->tol, "");
+  app.Options()->GetIntegerValue("max_iter", impl_->max_iter, "");
   if (app.Initialize() != Ipopt::Solve_Succeeded)
     throw InvalidOption("ipopt: initialization failed (check the [ipopt] options)");
 }
 
 IpoptSolver::~IpoptSolver() = default;
 
-NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_start, double tol) {
+NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_start, double tol,
+                             int max_iter) {
   const auto t0 = Clock::now();
   Ipopt::IpoptApplication& app = *impl_->app;
   app.Options()->SetNumericValue("tol", std::max(tol, impl_->tol));
+  app.Options()->SetIntegerValue(
+      "max_iter", max_iter > 0 ? std::min(max_iter, impl_->max_iter) : impl_->max_iter);
   const bool warm = warm_start && start.has_duals();
   app.Options()->SetStringValue("warm_start_init_point", warm ? "yes" : "no");
   std::string linear_solver;

@@ -31,8 +31,10 @@ class NlpSolver {
   virtual ~NlpSolver() = default;
   /// Solves from `start` (x; with duals when warm-starting) and overwrites it with the solution.
   /// tol > 0 replaces the configured convergence tolerance for this solve when it is looser
-  /// (the early NLPs of a homotopy); 0 keeps it.
-  virtual NlpResult solve(const BlockNlp& nlp, Iterate& start, bool warm_start, double tol) = 0;
+  /// (the early NLPs of a homotopy); 0 keeps it. max_iter > 0 replaces the configured iteration
+  /// limit when it is lower; 0 keeps it.
+  virtual NlpResult solve(const BlockNlp& nlp, Iterate& start, bool warm_start, double tol,
+                          int max_iter) = 0;
 };
 
 }  // namespace fesd::nlp

@@ -88,11 +88,13 @@ INSTANTIATE_TEST_SUITE_P(Modes, TinyMpcc, ::testing::ValuesIn(kAllModes), mode_n
 class RecordingSolver : public fesd::nlp::NlpSolver {
  public:
   fesd::nlp::NlpResult solve(const fesd::nlp::BlockNlp& nlp, fesd::nlp::Iterate& start,
-                             bool warm_start, double tol) override {
+                             bool warm_start, double tol, int max_iter) override {
     tols.push_back(tol);
-    return inner_.solve(nlp, start, warm_start, tol);
+    max_iters.push_back(max_iter);
+    return inner_.solve(nlp, start, warm_start, tol, max_iter);
   }
   std::vector<double> tols;
+  std::vector<int> max_iters;
 
  private:
   fesd::nlp::IpoptSolver inner_{fesd::NlpOptions{}};
@@ -181,6 +183,8 @@ TEST(SolveAgain, ChangesBoundsForOneNlpAndKeepsThePointIfItFails) {
   EXPECT_EQ(capped.rows[0].k, 9);
   EXPECT_EQ(capped.rows[0].sigma, sigma);
   EXPECT_EQ(solver.tols.back(), 0.0);  // the configured tolerance
+  EXPECT_EQ(solver.max_iters.back(), fesd::mpcc::kSolveAgainMaxIter);
+  EXPECT_EQ(solver.max_iters.front(), 0);  // the homotopy's NLPs: the configured limit
   EXPECT_NEAR(p.it.x[p.x], 0.5, 1e-8);
   EXPECT_NEAR(p.it.x[p.y], 0.0, 1e-8);
   EXPECT_EQ(p.nlp.x_lb, lb);
