@@ -158,6 +158,11 @@ struct StepEquilibrationEq {
   }
 };
 
+/// Whether region r is in a (sorted or not) list of regions.
+bool has(const std::vector<int>& regions, int r) {
+  return std::find(regions.begin(), regions.end(), r) != regions.end();
+}
+
 }  // namespace
 
 FesdInterval::FesdInterval(const Pss& model, const Tableau& tableau,
@@ -471,9 +476,6 @@ std::vector<int> FesdInterval::active_set(const double* w, int n) const {
 
 std::vector<int> FesdInterval::exit_regions(const Pss& model, const std::vector<int>& before,
                                             const std::vector<int>& after) {
-  auto has = [](const std::vector<int>& v, int r) {
-    return std::find(v.begin(), v.end(), r) != v.end();
-  };
   std::vector<int> exits;
   for (int k = 0; k < model.n_sys(); ++k) {
     const int first = model.region_offset(k), last = model.region_offset(k + 1);
@@ -495,9 +497,6 @@ std::vector<FesdInterval::ExitPin> FesdInterval::exits_to_pin(const double* w,
     for (int r : exit_regions(model_, active[n], active[n + 1])) pins.push_back({n, r, true});
   // An exit inside the last element: r slides there and has left the surface by its end.
   const int last = N_FE_ - 1;
-  auto has = [](const std::vector<int>& v, int r) {
-    return std::find(v.begin(), v.end(), r) != v.end();
-  };
   for (int k = 0; k < model_.n_sys(); ++k) {
     const int first = model_.region_offset(k), end = model_.region_offset(k + 1);
     auto slides = [&](const std::vector<int>& a, int r) {

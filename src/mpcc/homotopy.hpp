@@ -48,10 +48,10 @@ HomotopyResult solve_homotopy(nlp::BlockNlp& nlp, const Relaxation& relaxation,
 inline constexpr int kSolveAgainMaxIter = 100;
 
 /// Solves the last NLP of a homotopy once more (the same sigma, the configured tolerance, at most
-/// kSolveAgainMaxIter iterations, warm start from `it`) with the variable bounds and start point changed by `change` (e.g. sliding
-/// exits pinned), then restores the bounds. One row, numbered k; Success when it converges with
-/// a complementarity residual <= complementarity_tol. On Success `it` holds the new solution,
-/// otherwise it is left as it was.
+/// kSolveAgainMaxIter iterations, warm start from `it`) with the variable bounds and start point
+/// changed by `change` (e.g. sliding exits pinned), then restores the bounds. One row, numbered
+/// k; Success when it converges with a complementarity residual <= complementarity_tol. On
+/// Success `it` holds the new solution, otherwise it is left as it was.
 HomotopyResult solve_again(nlp::BlockNlp& nlp, const Relaxation& relaxation,
                            const std::vector<CompPair>& residual_pairs, nlp::NlpSolver& solver,
                            nlp::Iterate& it, double sigma, int k, const HomotopyOptions& options,
