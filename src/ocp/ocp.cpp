@@ -555,6 +555,10 @@ OcpResult solve(const Ocp& ocp, const OcpOptions& options) {
                                 b->iv[k]->pin_exit(problem, point, pin);
                             });
       on_row(again.rows.back());
+      if (options.progress)
+        std::fprintf(stderr, "%4s (row %d: the last NLP again, %zu sliding exit%s pinned%s)\n", "",
+                     again.rows.back().k, pins.size(), pins.size() == 1 ? "" : "s",
+                     again.status == Status::Success ? "" : "; failed, unpinned solution kept");
       res.homotopy.push_back(again.rows.back());
       res.nlp_iterations += again.nlp_iterations;
       res.derivative_s += again.eval_s;
