@@ -240,9 +240,12 @@ IntegratorResult integrate(const Pss& model, const Eigen::VectorXd& x0_in, doubl
   // Sliding exits of a solved step (docs/formulation.md): the exits inside it
   // (FesdInterval::exits_to_pin), and an exit at its start where the previous step ended with
   // theta > kExitThetaTol of the leaving region, are pinned and the last NLP solved again; if
-  // that fails, the unpinned solution stays.
-  auto pin_exits = [&](StepNlp& sn, nlp::Iterate& it, double sigma, int k,
+  // that fails, the unpinned solution stays. On success hr's complementarity residual becomes
+  // the pinned solution's.
+  auto pin_exits = [&](StepNlp& sn, nlp::Iterate& it, mpcc::HomotopyResult& hr,
                        std::vector<HomotopyRow>& rows) {
+    const double sigma = hr.rows.back().sigma;
+    const int k = static_cast<int>(rows.size());
     const discretization::FesdInterval& iv = *sn.iv;
     const std::vector<double>& w = it.x;
     std::vector<discretization::FesdInterval::ExitPin> pins =
@@ -282,10 +285,12 @@ IntegratorResult integrate(const Pss& model, const Eigen::VectorXd& x0_in, doubl
         });
     account(again);
     rows.insert(rows.end(), again.rows.begin(), again.rows.end());
-    if (again.status == Status::Success)
+    if (again.status == Status::Success) {
       res.summary.pinned_exits += static_cast<int>(pins.size());
-    else
+      hr.comp_residual = again.comp_residual;
+    } else {
       ++res.summary.pin_failures;
+    }
   };
 
   bool careful = false;  // an attempt of the current step failed (see solve_step)
@@ -349,7 +354,7 @@ IntegratorResult integrate(const Pss& model, const Eigen::VectorXd& x0_in, doubl
       solved = &fb;
     }
     if (hr.status == Status::Success && d.pin_sliding_exits && iv.can_pin_exits())
-      pin_exits(*solved, it, hr.rows.back().sigma, static_cast<int>(rows.size()), rows);
+      pin_exits(*solved, it, hr, rows);
     res.homotopy.push_back(std::move(rows));
     last_hr = hr;
     const std::vector<double>& w = it.x;
