@@ -16,7 +16,7 @@
 
 #include "discretization/fesd_interval.hpp"
 #include "fesd/model.hpp"
-#include "mpcc/homotopy.hpp"
+#include "mpcc/relaxation.hpp"
 #include "oscillator_model.hpp"
 
 namespace {

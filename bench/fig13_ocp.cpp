@@ -240,7 +240,7 @@ int main(int argc, char** argv) {
             run.cpu_s = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
             run.status = std::string(fesd::to_string(r.status));
             run.objective = r.objective;
-            run.iterations = r.nlp_iterations;
+            run.iterations = r.summary.nlp_iterations;
             run.nlps = static_cast<int>(r.homotopy.size());
             if (r.status == fesd::Status::Success) run.E = simulate_error(r, sim_steps);
           } catch (const fesd::Error& e) {

@@ -99,8 +99,8 @@ int main(int argc, char** argv) {
                                                         kCombos[c].mode, kCombos[c].cross_comp));
         r.x0 = res.x0()[0];
         r.objective = res.objective;
-        r.wall_s = res.wall_s;
-        r.iterations = res.nlp_iterations;
+        r.wall_s = res.summary.wall_s;
+        r.iterations = res.summary.nlp_iterations;
         r.nlps = static_cast<int>(res.homotopy.size());
         r.status = std::string(fesd::to_string(res.status));
       } catch (const fesd::Error& e) {

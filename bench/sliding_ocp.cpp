@@ -58,13 +58,13 @@ nlohmann::json row_json(const std::string& name, const fesd::OcpResult& r) {
           {"terminal_error", terminal_error(r)},
           {"comp_residual", r.comp_residual},
           {"nlps", r.homotopy.size()},
-          {"iterations", r.nlp_iterations},
-          {"wall_s", r.wall_s},
-          {"derivative_s", r.derivative_s},
-          {"solver_s", r.solver_s},
-          {"n_variables", r.n_variables},
-          {"pinned_exits", r.pinned_exits},
-          {"pin_failed", r.pin_failed},
+          {"iterations", r.summary.nlp_iterations},
+          {"wall_s", r.summary.wall_s},
+          {"derivative_s", r.summary.derivative_s},
+          {"solver_s", r.summary.solver_s},
+          {"n_variables", r.summary.n_variables},
+          {"pinned_exits", r.summary.pinned_exits},
+          {"pin_failures", r.summary.pin_failures},
           {"switch_times", [&] {
              std::vector<double> t;
              for (const auto& e : r.switches) t.push_back(e.t);
@@ -74,10 +74,12 @@ nlohmann::json row_json(const std::string& name, const fesd::OcpResult& r) {
 
 // pin: sliding exits pinned after the homotopy ("fail": the pinned NLP failed, unpinned kept).
 void print_row(const std::string& name, const fesd::OcpResult& r) {
-  fmt::print("{:<20} {:<22} {:>12.7f} {:>9.1e} {:>9.1e} {:>5} {:>6} {:>8.2f} {:>4}  {}\n", name,
-             fesd::to_string(r.status), r.objective, terminal_error(r), r.comp_residual,
-             r.homotopy.size(), r.nlp_iterations, r.wall_s,
-             r.pin_failed ? std::string("fail") : std::to_string(r.pinned_exits), sequence(r));
+  fmt::print(
+      "{:<20} {:<22} {:>12.7f} {:>9.1e} {:>9.1e} {:>5} {:>6} {:>8.2f} {:>4}  {}\n", name,
+      fesd::to_string(r.status), r.objective, terminal_error(r), r.comp_residual, r.homotopy.size(),
+      r.summary.nlp_iterations, r.summary.wall_s,
+      (r.summary.pin_failures > 0) ? std::string("fail") : std::to_string(r.summary.pinned_exits),
+      sequence(r));
 }
 
 void print_head() {
@@ -212,8 +214,8 @@ int main(int argc, char** argv) {
     fmt::print(
         "NLP size: {} variables (nosnoc_py: 1200); time: {:.2f} s derivatives, {:.2f} s "
         "IPOPT + MUMPS, {:.3f} s setup; {:.1f} ms per IPOPT iteration\n",
-        r.n_variables, r.derivative_s, r.solver_s, r.setup_s,
-        1e3 * r.wall_s / std::max(1, r.nlp_iterations));
+        r.summary.n_variables, r.summary.derivative_s, r.summary.solver_s, r.summary.setup_s,
+        1e3 * r.summary.wall_s / std::max(1, r.summary.nlp_iterations));
     out["peers_row"] = row_json("nosnoc variant", r);
     out["peers_row_pinned"] = row_json("nosnoc variant, exits pinned", pinned);
   }

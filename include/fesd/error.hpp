@@ -27,7 +27,8 @@ class InvalidModel : public Error {
   using Error::Error;
 };
 
-/// A problem file cannot be read or is malformed: "file.toml:12: unknown key 'n_S' (did you mean 'n_s'?)".
+/// A problem file cannot be read or is malformed: "file.toml:12: unknown key 'n_S' (did you mean
+/// 'n_s'?)".
 class ProblemFileError : public Error {
  public:
   using Error::Error;
@@ -35,6 +36,12 @@ class ProblemFileError : public Error {
 
 /// A math expression in a problem file does not parse or names an unknown symbol.
 class ExpressionError : public Error {
+ public:
+  using Error::Error;
+};
+
+/// An internal invariant of fesd failed: a bug, not bad input (CLI exit code 4).
+class InternalError : public Error {
  public:
   using Error::Error;
 };

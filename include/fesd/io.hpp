@@ -24,8 +24,8 @@ void write_plot(const IntegratorResult& result, const Pss& model, const std::str
 /// row per element boundary), "t_ctrl" (N_stages + 1 control grid points), "u" (one row per
 /// control interval), "h", "interval" (control interval of each element), "eta" (per element,
 /// null at interval starts), "switch_times", "x0", "x_final", "homotopy" (one object per NLP),
-/// "stats" (homotopy_steps, nlp_iterations, wall_s, derivative_s, solver_s, setup_s,
-/// n_variables, n_constraints, comp_residual, mpcc_mode), then "t_stage", "x_stage", "theta",
+/// "stats" (the keys of the integrator's "stats", i.e. the fields of fesd::Summary, plus
+/// comp_residual and mpcc_mode), then "t_stage", "x_stage", "theta",
 /// "lambda", "active_set", "switches", "state_names", "control_names". Non-finite numbers are
 /// null. Throws fesd::IoError.
 void write_json(const OcpResult& result, const Pss& model, const std::string& path);

@@ -42,6 +42,7 @@
 #include "fesd/model.hpp"
 #include "fesd/options.hpp"
 #include "fesd/status.hpp"
+#include "fesd/summary.hpp"
 
 namespace fesd {
 
@@ -110,9 +111,9 @@ struct OcpOptions {
   /// Evaluate path constraints and state bounds at the RK stage points too, not only at the
   /// element boundaries.
   bool constraints_at_stages = false;
-  /// Print one line per homotopy step (sigma, residual, objective, inf_pr, iterations, status,
-  /// time) to stderr.
-  bool progress = false;
+  /// Called after every NLP of the homotopy, the pinned re-solve included (the CLI prints
+  /// format_homotopy_row() of it); the library itself never prints.
+  HomotopyCallback on_homotopy_row;
 };
 
 /// Empty if valid, else one line per broken rule.
@@ -141,20 +142,15 @@ struct OcpResult {
   std::vector<Eigen::VectorXd> x_stage;  ///< stage states
   std::vector<Eigen::VectorXd> theta, lambda;
 
-  std::vector<HomotopyRow> homotopy;  ///< one row per NLP
-  /// Sliding exits pinned after the homotopy (DiscretizationOptions::pin_sliding_exits): the
-  /// last NLP was solved once more (the last row of `homotopy`). pin_failed: that solve failed
-  /// and the result is the unpinned solution.
-  int pinned_exits = 0;
-  bool pin_failed = false;
-  int nlp_iterations = 0;
-  int n_variables = 0, n_constraints = 0;
-  double wall_s = 0, derivative_s = 0, solver_s = 0, setup_s = 0;
+  std::vector<HomotopyRow> homotopy;  ///< one row per NLP (a pinned re-solve last)
+  Summary summary;                    ///< work and time; n_variables, n_constraints: the NLP
 
   Eigen::VectorXd x0() const { return x.empty() ? Eigen::VectorXd() : x.front(); }
   Eigen::VectorXd x_final() const { return x.empty() ? Eigen::VectorXd() : x.back(); }
-  /// A multi-line human summary (status, objective, switches, homotopy table, timing).
-  std::string report() const;
+  /// One line: status, objective, x(0), number of switches, time.
+  std::string brief_report() const;
+  /// A multi-line human summary (status, objective, switches, homotopy table, work and timing).
+  std::string full_report() const;
 };
 
 /// Solves the OCP. Throws fesd::InvalidModel / InvalidOption for bad input (dimensions, NaN,

@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "fesd/summary.hpp"
 #include "fesd/tableau.hpp"
 
 namespace fesd {
@@ -136,8 +137,9 @@ struct IntegratorOptions {
   DiscretizationOptions discretization;
   HomotopyOptions homotopy;
   NlpOptions nlp;
-  /// Print one progress line per integration step to stderr (the CLI turns it on).
-  bool progress = false;
+  /// Called after every integration step (the CLI prints format_step_progress() of it); the
+  /// library itself never prints.
+  StepCallback on_step;
 };
 
 /// Empty if valid, else one line per broken rule: "discretization.n_s = 0: must be >= 1".

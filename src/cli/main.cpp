@@ -472,6 +472,19 @@ int finish(const Result& result, const std::string& report, const fesd::Pss& mod
   return fesd::exit_code(result.status);
 }
 
+/// Progress lines on stderr: one per integration step, or the homotopy table of an OCP.
+void show_progress(fesd::IntegratorOptions& o) {
+  o.on_step = [](const fesd::StepProgress& p) {
+    std::cerr << fesd::format_step_progress(p) << std::flush;
+  };
+}
+void show_progress(fesd::OcpOptions& o) {
+  std::cerr << fesd::homotopy_table_header() << std::flush;
+  o.on_homotopy_row = [](const fesd::HomotopyRow& r) {
+    std::cerr << fesd::format_homotopy_row(r) << std::flush;
+  };
+}
+
 /// Loads the problem file with the overrides, checks the output paths (before a possibly long
 /// solve), prints the header unless --quiet, and turns progress lines on unless --quiet.
 template <class Problem>
@@ -483,7 +496,7 @@ Problem prepare(const SolveArgs& args, const CLI::App& cmd) {
     fmt::print("\n");
     std::fflush(stdout);
   }
-  problem.options.progress = !args.quiet;
+  if (!args.quiet) show_progress(problem.options);
   return problem;
 }
 
@@ -498,7 +511,7 @@ int run_simulate(const SolveArgs& args, const CLI::App& cmd) {
 int run_solve(const SolveArgs& args, const CLI::App& cmd) {
   const auto problem = prepare<fesd::OcpProblem>(args, cmd);
   const fesd::OcpResult result = fesd::solve(problem.ocp, problem.options);
-  return finish(result, result.report(), problem.ocp.model, problem.name, args, cmd,
+  return finish(result, result.full_report(), problem.ocp.model, problem.name, args, cmd,
                 "optimal control problem");
 }
 

@@ -436,11 +436,10 @@ void FesdInterval::build_complementarity() {
   }
 }
 
-void FesdInterval::set_guess(nlp::BlockNlp& nlp, const Eigen::VectorXd& x0,
+void FesdInterval::set_guess(std::vector<double>& w, const Eigen::VectorXd& x0,
                              const dcs::LpSolution& lp, const Eigen::VectorXd& xdot) const {
   const int n_x = model_.n_x(), n_th = model_.n_theta(), n_sys = model_.n_sys();
   const double h0 = in_.T / N_FE_;
-  auto& w = nlp.x_init;
   for (int n = 0; n <= N_FE_; ++n)
     for (int i = 0; i < n_x; ++i) w[x(n, i)] = x0[i] + n * h0 * xdot[i];
   for (int n = 0; n < N_FE_; ++n) {
@@ -461,7 +460,7 @@ void FesdInterval::set_guess(nlp::BlockNlp& nlp, const Eigen::VectorXd& x0,
       for (int k = 0; k < n_sys; ++k) w[mu_end_[n][k]] = lp.mu[k];
     }
   }
-  update_lifted_guess(nlp);
+  update_lifted_guess(w);
 }
 
 std::vector<int> FesdInterval::active_set(const double* w, int n) const {
@@ -518,21 +517,16 @@ std::vector<FesdInterval::ExitPin> FesdInterval::exits_to_pin(const double* w,
   return pins;
 }
 
-void FesdInterval::pin_exit(nlp::BlockNlp& nlp, std::vector<double>& w, const ExitPin& pin) const {
+std::vector<nlp::Bound> FesdInterval::pin_exit(const ExitPin& pin) const {
   if (!can_pin_exits())
-    throw Error("internal: FesdInterval::pin_exit needs FESD, stiffly accurate");
-  for (int s = 0; s < n_s_; ++s) {
-    const int l = lambda(pin.n, s, pin.r);
-    nlp.x_lb[l] = nlp.x_ub[l] = w[l] = 0.0;
-  }
-  if (pin.theta_zero) {
-    const int th = theta(pin.n, n_s_ - 1, pin.r);
-    nlp.x_ub[th] = w[th] = 0.0;
-  }
+    throw InternalError("FesdInterval::pin_exit needs FESD with a stiffly accurate scheme");
+  std::vector<nlp::Bound> bounds;
+  for (int s = 0; s < n_s_; ++s) bounds.push_back({lambda(pin.n, s, pin.r), 0.0, 0.0});
+  if (pin.theta_zero) bounds.push_back({theta(pin.n, n_s_ - 1, pin.r), 0.0, 0.0});  // theta >= 0
+  return bounds;
 }
 
-void FesdInterval::update_lifted_guess(nlp::BlockNlp& nlp) const {
-  auto& w = nlp.x_init;
+void FesdInterval::update_lifted_guess(std::vector<double>& w) const {
   for (std::size_t n = 0; n < lam_sum_.size(); ++n)
     for (std::size_t r = 0; r < lam_sum_[n].size(); ++r) {
       double sl = 0, st = 0;

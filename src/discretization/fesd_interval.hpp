@@ -63,9 +63,9 @@ class FesdInterval {
   /// Adds variables and constraint/objective blocks to `nlp`.
   void build(nlp::BlockNlp& nlp, const IntervalInputs& in);
 
-  /// Sets the initial guess of every variable of the interval: states on the explicit Euler
+  /// Sets the initial guess w of every variable of the interval: states on the explicit Euler
   /// prediction from x0 with derivative xdot, algebraic variables from the LP solution.
-  void set_guess(nlp::BlockNlp& nlp, const Eigen::VectorXd& x0, const dcs::LpSolution& lp,
+  void set_guess(std::vector<double>& w, const Eigen::VectorXd& x0, const dcs::LpSolution& lp,
                  const Eigen::VectorXd& xdot) const;
 
   // ---- layout (valid after build); n: element, m: stage 0..n_s-1, i: state, r: region ----
@@ -131,10 +131,10 @@ class FesdInterval {
   /// OCP interval, whose control changes at its end), in the last element without theta_zero:
   /// the mode is kept to the interval end, where the new control may end it.
   std::vector<ExitPin> exits_to_pin(const double* w, bool control_jump_at_end) const;
-  /// Pins an exit by the variable bounds: lambda_{n,m,r} = 0 at every stage (element n stays on
+  /// The variable bounds that pin an exit: lambda_{n,m,r} = 0 at every stage (element n stays on
   /// the surface) and, with theta_zero, theta_{n,n_s,r} = 0 (the region's weight reaches 0 at
-  /// t_{n+1}). Sets the same values in w.
-  void pin_exit(nlp::BlockNlp& nlp, std::vector<double>& w, const ExitPin& pin) const;
+  /// t_{n+1}).
+  std::vector<nlp::Bound> pin_exit(const ExitPin& pin) const;
   /// Between two integration steps an exit is pinned only when theta of the leaving region at
   /// the end of the step before exceeds this (below it the exit is early by ~ theta / |d theta /
   /// dt|, an error ~1e-12 in the state); else the first element would have to slide on without
@@ -143,9 +143,9 @@ class FesdInterval {
   /// lambda at the end of an element above which the state has left the surface (the state
   /// error is about this size); the NLP's own noise in lambda is ~1e-10.
   static constexpr double kExitLambdaTol = 1e-9;
-  /// Recomputes the lifted sums of step equilibration (if any) from the other entries of
-  /// nlp.x_init; call after changing the guess of lambda or theta.
-  void update_lifted_guess(nlp::BlockNlp& nlp) const;
+  /// Recomputes the lifted sums of step equilibration (if any) in the guess w from its other
+  /// entries; call after changing the guess of lambda or theta.
+  void update_lifted_guess(std::vector<double>& w) const;
   /// eta_n (31) at a solution x, n = 1..N_FE-1 (entry 0 unused, set to NaN).
   std::vector<double> eta(const double* x) const;
 

@@ -51,6 +51,8 @@ json stats(const Summary& s) {
               {"derivative_s", number(s.derivative_s)},
               {"solver_s", number(s.solver_s)},
               {"setup_s", number(s.setup_s)},
+              {"n_variables", s.n_variables},
+              {"n_constraints", s.n_constraints},
               {"max_comp_residual", number(s.max_comp_residual)},
               {"fallback_steps", s.fallback_steps},
               {"refined_steps", s.refined_steps},
@@ -269,18 +271,10 @@ void write_json(const OcpResult& result, const Pss& model, const std::string& pa
   json homotopy_rows = json::array();
   for (const HomotopyRow& r : result.homotopy) homotopy_rows.push_back(homotopy_row(r));
   j["homotopy"] = std::move(homotopy_rows);
-  j["stats"] = json{{"homotopy_steps", result.homotopy.size()},
-                    {"nlp_iterations", result.nlp_iterations},
-                    {"wall_s", number(result.wall_s)},
-                    {"derivative_s", number(result.derivative_s)},
-                    {"solver_s", number(result.solver_s)},
-                    {"setup_s", number(result.setup_s)},
-                    {"n_variables", result.n_variables},
-                    {"n_constraints", result.n_constraints},
-                    {"comp_residual", number(result.comp_residual)},
-                    {"mpcc_mode", std::string(to_string(result.mpcc_mode))},
-                    {"pinned_exits", result.pinned_exits},
-                    {"pin_failed", result.pin_failed}};
+  json st = stats(result.summary);
+  st["comp_residual"] = number(result.comp_residual);
+  st["mpcc_mode"] = std::string(to_string(result.mpcc_mode));
+  j["stats"] = std::move(st);
   j["t_stage"] = array(result.t_stage);
   j["x_stage"] = rows(result.x_stage);
   j["theta"] = rows(result.theta);

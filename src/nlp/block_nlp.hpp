@@ -1,10 +1,11 @@
 // src/nlp/block_nlp.hpp: an NLP assembled from blocks,
 //
-//   min  sum_o weight_o * f_o(x[vars_o])    s.t.  g_lb <= c_b(x[vars_b]) <= g_ub,  x_lb <= x <= x_ub,
+//   min  sum_o weight_o * f_o(x[vars_o])    s.t.  g_lb <= c_b(x[vars_b]) <= g_ub,  x_lb <= x <=
+//   x_ub,
 //
 // with the sparsity of the constraint Jacobian and of the Hessian of the Lagrangian taken from the
-// block structure (each block's own pattern mapped through its variable indices, duplicates merged).
-// Knows nothing of models or FESD: variables are numbers, blocks are functions.
+// block structure (each block's own pattern mapped through its variable indices, duplicates
+// merged). Knows nothing of models or FESD: variables are numbers, blocks are functions.
 #pragma once
 #include <limits>
 #include <memory>
@@ -16,6 +17,12 @@
 namespace fesd::nlp {
 
 inline constexpr double kInf = 1e20;  // IPOPT treats |bound| >= 1e19 as infinite
+
+/// New bounds lb <= x[var] <= ub of one variable (e.g. a sliding exit pinned).
+struct Bound {
+  int var = -1;
+  double lb = 0, ub = 0;
+};
 
 class BlockNlp {
  public:
@@ -60,8 +67,8 @@ class BlockNlp {
   struct Instance {
     std::shared_ptr<const Block> block;
     std::vector<int> vars;
-    int row0 = -1;         // first constraint row, -1 for an objective term
-    double weight = 1.0;   // objective terms only
+    int row0 = -1;        // first constraint row, -1 for an objective term
+    double weight = 1.0;  // objective terms only
     const BlockPattern* pattern = nullptr;
     std::vector<int> jac_index;   // per (r, i) pattern entry: position in the Jacobian values
     std::vector<int> hess_index;  // per pattern pair: position in the Hessian values

@@ -1,6 +1,7 @@
 // src/nlp/nlp_solver.hpp: the small interface the MPCC layer solves NLPs through. IPOPT + MUMPS is
 // the one backend today; a structure-exploiting solver can replace it behind this interface.
 #pragma once
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -36,5 +37,10 @@ class NlpSolver {
   virtual NlpResult solve(const BlockNlp& nlp, Iterate& start, bool warm_start, double tol,
                           int max_iter) = 0;
 };
+
+/// The NLP solver every front end uses: IPOPT + MUMPS (or the dense KKT module for small NLPs).
+/// One factory, so that another backend can replace IPOPT without touching a front end. Throws
+/// fesd::InvalidOption if the backend rejects an option (the message names it).
+std::unique_ptr<NlpSolver> make_solver(const NlpOptions& options);
 
 }  // namespace fesd::nlp

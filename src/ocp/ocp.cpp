@@ -13,14 +13,13 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include "core/report.hpp"
 #include "dcs/stewart.hpp"
 #include "discretization/fesd_interval.hpp"
 #include "fesd/error.hpp"
-#include "mpcc/homotopy.hpp"
+#include "mpcc/problem.hpp"
 #include "nlp/block.hpp"
 #include "nlp/block_nlp.hpp"
-#include "nlp/ipopt_solver.hpp"
+#include "nlp/nlp_solver.hpp"
 #include "nlp/sum_block.hpp"
 
 namespace fesd {
@@ -195,15 +194,14 @@ void check_input(const Ocp& ocp, const OcpOptions& o) {
 
 // ---- the NLP -----------------------------------------------------------------------------------
 
+/// The MPCC of the OCP (59)-(60) and where its pieces live.
 struct OcpNlp {
-  nlp::BlockNlp nlp;
+  mpcc::Problem mpcc;
   Tableau tab;
   std::vector<int> s0, p;
   std::vector<std::vector<int>> q;  // per interval
   std::vector<std::unique_ptr<FesdInterval>> iv;
   std::vector<IntervalInputs> in;
-  std::vector<discretization::CompGroup> groups;
-  std::vector<discretization::CompPair> residual_pairs;
   std::vector<int> terminal_slacks;
 };
 
@@ -213,18 +211,19 @@ std::unique_ptr<OcpNlp> build(const Ocp& ocp, const OcpOptions& o, const Eigen::
   const int n_x = m.n_x(), n_u = m.n_u(), n_p = m.n_p(), n_th = m.n_theta(), n_sys = m.n_sys();
   auto b = std::make_unique<OcpNlp>();
   b->tab = make_tableau(d.rk_scheme, d.n_s);
-  nlp::BlockNlp& nlp = b->nlp;
+  mpcc::Problem& mp = b->mpcc;
+  nlp::BlockNlp& nlp = mp.nlp();
   const bool x0_free = ocp.lbx0.size() > 0;
 
   // s0: fixed to x0, or free within [lbx0, ubx0] intersected with [lbx, ubx].
   b->s0 = range(nlp.add_variables(n_x, 0.0, 0.0, 0.0), n_x);
-  for (int i = 0; i < n_x; ++i) {
-    nlp.x_init[b->s0[i]] = ocp.x0[i];
-    nlp.x_lb[b->s0[i]] = x0_free ? std::max(lower(ocp.lbx0, i), lower(ocp.lbx, i)) : ocp.x0[i];
-    nlp.x_ub[b->s0[i]] = x0_free ? std::min(upper(ocp.ubx0, i), upper(ocp.ubx, i)) : ocp.x0[i];
-  }
+  mp.fix(b->s0, ocp.x0);
+  if (x0_free)
+    for (int i = 0; i < n_x; ++i)
+      mp.bound(b->s0[i], std::max(lower(ocp.lbx0, i), lower(ocp.lbx, i)),
+               std::min(upper(ocp.ubx0, i), upper(ocp.ubx, i)));
   b->p = range(nlp.add_variables(n_p, 0.0, 0.0, 0.0), n_p);
-  for (int i = 0; i < n_p; ++i) nlp.x_lb[b->p[i]] = nlp.x_ub[b->p[i]] = nlp.x_init[b->p[i]] = p[i];
+  mp.fix(b->p, p);
   // The standard method does not use lambda_{0,0}: fixed dummies.
   std::vector<int> dummy_lambda, dummy_mu;
   if (!d.use_fesd) {
@@ -237,10 +236,9 @@ std::unique_ptr<OcpNlp> build(const Ocp& ocp, const OcpOptions& o, const Eigen::
   for (int k = 0; k < ocp.N_stages; ++k) {
     std::vector<int> q = range(nlp.add_variables(n_u, 0.0, 0.0, 0.0), n_u);
     for (int i = 0; i < n_u; ++i) {
-      nlp.x_lb[q[i]] = lower(ocp.lbu, i);
-      nlp.x_ub[q[i]] = upper(ocp.ubu, i);
+      mp.bound(q[i], lower(ocp.lbu, i), upper(ocp.ubu, i));
       const double g = ocp.u_guess.size() > 0 ? ocp.u_guess[i] : 0.0;
-      nlp.x_init[q[i]] = std::clamp(g, nlp.x_lb[q[i]], nlp.x_ub[q[i]]);
+      mp.guess()[q[i]] = std::clamp(g, mp.lower(q[i]), mp.upper(q[i]));
     }
     b->q.push_back(q);
     IntervalInputs in;
@@ -290,10 +288,9 @@ std::unique_ptr<OcpNlp> build(const Ocp& ocp, const OcpOptions& o, const Eigen::
     path_ub[i] = upper(ocp.ubg_path, i);
   }
   auto bound_state = [&](int first) {
-    for (int i = 0; i < n_x; ++i) {
-      nlp.x_lb[first + i] = std::max(nlp.x_lb[first + i], lower(ocp.lbx, i));
-      nlp.x_ub[first + i] = std::min(nlp.x_ub[first + i], upper(ocp.ubx, i));
-    }
+    for (int i = 0; i < n_x; ++i)
+      mp.bound(first + i, std::max(mp.lower(first + i), lower(ocp.lbx, i)),
+               std::min(mp.upper(first + i), upper(ocp.ubx, i)));
   };
   auto add_path = [&](int x_first, const std::vector<int>& q) {
     if (!path) return;
@@ -354,11 +351,8 @@ std::unique_ptr<OcpNlp> build(const Ocp& ocp, const OcpOptions& o, const Eigen::
     }
   }
 
-  for (const auto& iv : b->iv) {
-    b->groups.insert(b->groups.end(), iv->groups().begin(), iv->groups().end());
-    b->residual_pairs.insert(b->residual_pairs.end(), iv->residual_pairs().begin(),
-                             iv->residual_pairs().end());
-  }
+  for (const auto& iv : b->iv) mp.add_complementarity(iv->groups(), iv->residual_pairs());
+  mp.relax(o.homotopy.mpcc_mode);
   return b;
 }
 
@@ -368,8 +362,8 @@ std::unique_ptr<OcpNlp> build(const Ocp& ocp, const OcpOptions& o, const Eigen::
 void guess_constant(OcpNlp& b, const Ocp& ocp, const Eigen::VectorXd& p) {
   const dcs::LpSolution lp = dcs::solve_lp(ocp.model, ocp.x0, p);
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(ocp.model.n_x());
-  for (const auto& iv : b.iv) iv->set_guess(b.nlp, ocp.x0, lp, zero);
-  auto& w = b.nlp.x_init;
+  auto& w = b.mpcc.guess();
+  for (const auto& iv : b.iv) iv->set_guess(w, ocp.x0, lp, zero);
   const auto& in0 = b.in.front();
   if (in0.lp_at_start) {
     for (int r = 0; r < ocp.model.n_theta(); ++r) w[in0.lambda_start[r]] = lp.lambda[r];
@@ -405,12 +399,12 @@ bool guess_simulation(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Eige
   const std::size_t elements = static_cast<std::size_t>(N_FE.front() * ocp.N_stages);
   if (r.status != Status::Success || r.h.size() != elements) return false;
   guess_constant(b, ocp, p);  // everything the simulation does not give
-  auto& w = b.nlp.x_init;
+  auto& w = b.mpcc.guess();
   int e = 0;
   for (const auto& ivp : b.iv) {
     const FesdInterval& iv = *ivp;
     for (int n = 0; n < iv.N_FE(); ++n, ++e) {
-      w[iv.h(n)] = std::clamp(r.h[e], b.nlp.x_lb[iv.h(n)], b.nlp.x_ub[iv.h(n)]);
+      w[iv.h(n)] = std::clamp(r.h[e], b.mpcc.lower(iv.h(n)), b.mpcc.upper(iv.h(n)));
       for (int i = 0; i < n_x; ++i) w[iv.x(n + 1, i)] = r.x[e + 1][i];
       for (int s = 0; s < n_s; ++s) {
         const std::size_t st = static_cast<std::size_t>(e * n_s + s);
@@ -433,7 +427,7 @@ bool guess_simulation(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Eige
         for (int j = 0; j < n_sys; ++j) w[iv.mu_end(n, j)] = lp.mu[j];
       }
     }
-    iv.update_lifted_guess(b.nlp);
+    iv.update_lifted_guess(w);
   }
   return true;
 }
@@ -505,36 +499,28 @@ OcpResult solve(const Ocp& ocp, const OcpOptions& options) {
         fmt::format("ocp.p has {} entries, expected n_p = {}", p.size(), ocp.model.n_p()));
 
   std::unique_ptr<OcpNlp> b = build(ocp, options, p);
+  mpcc::Problem& mp = b->mpcc;
   OcpResult res;
   res.mpcc_mode = options.homotopy.mpcc_mode;
   bool simulated = false;
   if (options.initialization == OcpInitialization::Simulation)
     simulated = guess_simulation(*b, ocp, options, p);
   if (!simulated) guess_constant(*b, ocp, p);
-  const mpcc::Relaxation relaxation(b->nlp, b->groups, options.homotopy.mpcc_mode);
-  b->nlp.finalize();
-  res.n_variables = b->nlp.num_variables();
-  res.n_constraints = b->nlp.num_constraints();
-  res.setup_s = seconds_since(t_start);
+  mp.finalize();
+  res.summary.n_variables = mp.num_variables();
+  res.summary.n_constraints = mp.num_constraints();
+  res.summary.setup_s = seconds_since(t_start);
 
-  nlp::IpoptSolver solver(options.nlp);
-  nlp::Iterate it;
-  it.x = b->nlp.x_init;
-  if (options.progress)
-    std::fprintf(stderr, "%4s %9s %10s %14s %9s %5s  %-26s %8s\n", "k", "sigma", "comp",
-                 "objective", "inf_pr", "iter", "IPOPT status", "time s");
-  auto on_row = [&](const HomotopyRow& r) {
-    if (options.progress)
-      std::fprintf(stderr, "%4d %9.1e %10.2e %14.7e %9.1e %5d  %-26s %8.3f\n", r.k, r.sigma,
-                   r.comp_residual, r.objective, r.inf_pr, r.nlp_iterations, r.nlp_status.c_str(),
-                   r.cpu_s);
+  const std::unique_ptr<nlp::NlpSolver> solver = nlp::make_solver(options.nlp);
+  auto account = [&](const mpcc::HomotopyResult& h) {
+    res.homotopy.insert(res.homotopy.end(), h.rows.begin(), h.rows.end());
+    res.summary.homotopy_steps += static_cast<int>(h.rows.size());
+    res.summary.nlp_iterations += h.nlp_iterations;
+    res.summary.derivative_s += h.eval_s;
+    res.summary.solver_s += h.solver_s;
   };
-  mpcc::HomotopyResult hr = mpcc::solve_homotopy(b->nlp, relaxation, b->residual_pairs, solver, it,
-                                                 options.homotopy, on_row);
-  res.homotopy = hr.rows;
-  res.nlp_iterations = hr.nlp_iterations;
-  res.derivative_s = hr.eval_s;
-  res.solver_s = hr.solver_s;
+  mpcc::HomotopyResult hr = mp.solve_homotopy(*solver, options.homotopy, options.on_homotopy_row);
+  account(hr);
   // Sliding exits left early (docs/formulation.md): pin them and solve the last NLP once more;
   // if that fails, the unpinned solution stays.
   if (hr.status == Status::Success && options.discretization.pin_sliding_exits &&
@@ -542,49 +528,52 @@ OcpResult solve(const Ocp& ocp, const OcpOptions& options) {
     // Per control interval: at their boundaries the control jumps, and with it the sliding
     // vector field, so a mode may end there with theta > 0; one that ends inside the last
     // element of an interval is kept on the surface up to the boundary instead.
-    std::vector<std::pair<int, FesdInterval::ExitPin>> pins;  // (interval, pin)
-    for (int k = 0; k < ocp.N_stages; ++k)
-      for (const auto& pin : b->iv[k]->exits_to_pin(it.x.data(), /*control_jump_at_end=*/true))
-        pins.emplace_back(k, pin);
-    if (!pins.empty()) {
-      const mpcc::HomotopyResult again =
-          mpcc::solve_again(b->nlp, relaxation, b->residual_pairs, solver, it, hr.rows.back().sigma,
-                            static_cast<int>(hr.rows.size()), options.homotopy,
-                            [&](nlp::BlockNlp& problem, std::vector<double>& point) {
-                              for (const auto& [k, pin] : pins)
-                                b->iv[k]->pin_exit(problem, point, pin);
-                            });
-      on_row(again.rows.back());
-      if (options.progress)
-        std::fprintf(stderr, "%4s (row %d: the last NLP again, %zu sliding exit%s pinned%s)\n", "",
-                     again.rows.back().k, pins.size(), pins.size() == 1 ? "" : "s",
-                     again.status == Status::Success ? "" : "; failed, unpinned solution kept");
-      res.homotopy.push_back(again.rows.back());
-      res.nlp_iterations += again.nlp_iterations;
-      res.derivative_s += again.eval_s;
-      res.solver_s += again.solver_s;
+    std::vector<nlp::Bound> bounds;
+    int n_pins = 0;
+    for (const auto& iv : b->iv)
+      for (const auto& pin : iv->exits_to_pin(mp.solution().data(), /*control_jump_at_end=*/true)) {
+        ++n_pins;
+        for (const nlp::Bound& bd : iv->pin_exit(pin)) bounds.push_back(bd);
+      }
+    if (n_pins > 0) {
+      const mpcc::HomotopyResult again = mp.solve_again(*solver, options.homotopy, bounds, n_pins);
+      if (options.on_homotopy_row) options.on_homotopy_row(again.rows.back());
+      account(again);
       if (again.status == Status::Success) {
-        res.pinned_exits = static_cast<int>(pins.size());
+        res.summary.pinned_exits = n_pins;
         hr.comp_residual = again.comp_residual;
       } else {
-        res.pin_failed = true;
+        ++res.summary.pin_failures;
       }
     }
   }
   res.status = hr.status;
   res.comp_residual = hr.comp_residual;
-  extract(*b, ocp, it.x, p, res);
+  res.summary.max_comp_residual = hr.comp_residual;
+  extract(*b, ocp, mp.solution(), p, res);
   res.message = res.status == Status::Success
                     ? std::string(describe(Status::Success))
                     : fmt::format("{} (last IPOPT status {}, complementarity residual {:.2e})",
                                   describe(hr.status), hr.last_nlp_status, hr.comp_residual);
   if (options.initialization == OcpInitialization::Simulation && !simulated)
     res.message += " [the initializing simulation failed or used another grid: constant guess]";
-  res.wall_s = seconds_since(t_start);
+  res.summary.wall_s = seconds_since(t_start);
   return res;
 }
 
-std::string OcpResult::report() const {
+std::string OcpResult::brief_report() const {
+  std::string x0s;
+  if (!x.empty())
+    for (Eigen::Index i = 0; i < x.front().size(); ++i)
+      x0s += fmt::format("{}{:.10g}", i ? ", " : "", x.front()[i]);
+  return fmt::format(
+      "{}: objective {:.10g}, x(0) = [{}], {} switch{}, {} NLPs, {} IPOPT "
+      "iterations, {:.3f} s",
+      to_string(status), objective, x0s, switches.size(), switches.size() == 1 ? "" : "es",
+      summary.homotopy_steps, summary.nlp_iterations, summary.wall_s);
+}
+
+std::string OcpResult::full_report() const {
   std::ostringstream os;
   auto vec = [](const Eigen::VectorXd& v) {
     std::string s;
@@ -601,29 +590,12 @@ std::string OcpResult::report() const {
     os << fmt::format("  x(T)                 {}\n", vec(x.back()));
   }
   os << fmt::format("  switches             {}\n", switches.size());
-  for (const auto& s : switches) os << detail::format_switch(s);
-  os << fmt::format("  NLP size             {} variables, {} constraints\n", n_variables,
-                    n_constraints);
-  os << fmt::format("  homotopy             {} NLPs, {} IPOPT iterations\n", homotopy.size(),
-                    nlp_iterations);
-  if (pinned_exits > 0 || pin_failed)
-    os << fmt::format("  sliding exits        {}\n",
-                      pin_failed
-                          ? "pinning failed (unpinned solution kept)"
-                          : fmt::format("{} pinned (last row: the pinned NLP)", pinned_exits));
-  os << fmt::format("    {:>3} {:>9} {:>10} {:>14} {:>9} {:>5}  {:<26} {:>8}\n", "k", "sigma",
-                    "comp", "objective", "inf_pr", "iter", "IPOPT status", "time s");
-  for (const auto& r : homotopy)
-    os << fmt::format("    {:>3} {:>9.1e} {:>10.2e} {:>14.7e} {:>9.1e} {:>5}  {:<26} {:>8.3f}\n",
-                      r.k, r.sigma, r.comp_residual, r.objective, r.inf_pr, r.nlp_iterations,
-                      r.nlp_status, r.cpu_s);
-  const double busy = derivative_s + solver_s;
-  os << fmt::format("  wall time            {:.3f} s\n", wall_s);
-  os << fmt::format("    derivatives        {:.3f} s  ({:.0f} %)\n", derivative_s,
-                    busy > 0 ? 100 * derivative_s / busy : 0.0);
-  os << fmt::format("    IPOPT + MUMPS      {:.3f} s  ({:.0f} %)\n", solver_s,
-                    busy > 0 ? 100 * solver_s / busy : 0.0);
-  os << fmt::format("    setup              {:.3f} s\n", setup_s);
+  for (const auto& s : switches) os << format_switch(s);
+  os << fmt::format("  NLP size             {} variables, {} constraints\n", summary.n_variables,
+                    summary.n_constraints);
+  os << "  homotopy\n" << homotopy_table_header();
+  for (const auto& r : homotopy) os << format_homotopy_row(r);
+  os << format_work(summary);
   return os.str();
 }
 

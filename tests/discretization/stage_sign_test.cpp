@@ -11,7 +11,7 @@
 
 #include "discretization/fesd_interval.hpp"
 #include "fesd/model.hpp"
-#include "mpcc/homotopy.hpp"
+#include "mpcc/relaxation.hpp"
 
 namespace {
 

@@ -75,13 +75,14 @@ fesd::OcpResult make_result() {
   r.homotopy = {
       fesd::HomotopyRow{0, 1.0, 0.5, 2.0, 1e-12, 7, "Solve_Succeeded", 0.001, "mumps"},
       fesd::HomotopyRow{1, 0.1, 1e-10, 1.25, 2e-13, 3, "Solve_Succeeded", 0.002, "mumps"}};
-  r.nlp_iterations = 10;
-  r.n_variables = 100;
-  r.n_constraints = 90;
-  r.wall_s = 0.5;
-  r.derivative_s = 0.125;
-  r.solver_s = 0.25;
-  r.setup_s = 0.0625;
+  r.summary.homotopy_steps = 2;
+  r.summary.nlp_iterations = 10;
+  r.summary.n_variables = 100;
+  r.summary.n_constraints = 90;
+  r.summary.wall_s = 0.5;
+  r.summary.derivative_s = 0.125;
+  r.summary.solver_s = 0.25;
+  r.summary.setup_s = 0.0625;
   return r;
 }
 

@@ -14,9 +14,9 @@
 #include "fesd/integrator.hpp"
 #include "fesd/model.hpp"
 #include "fesd/problem_file.hpp"
-#include "mpcc/homotopy.hpp"
+#include "mpcc/problem.hpp"
 #include "nlp/block.hpp"
-#include "nlp/ipopt_solver.hpp"
+#include "nlp/nlp_solver.hpp"
 
 namespace {
 
@@ -47,19 +47,18 @@ struct DistanceTo {
 // minimizers, (1, 0) and (0, 1), both with objective 1; the start lies on the side of (1, 0).
 class TinyMpcc : public ::testing::TestWithParam<MpccMode> {};
 TEST_P(TinyMpcc, ReachesTheLocalMinimizerOfTheStart) {
-  fesd::nlp::BlockNlp nlp;
+  fesd::mpcc::Problem problem;
+  fesd::nlp::BlockNlp& nlp = problem.nlp();
   const int x = nlp.add_variables(1, 0.0, fesd::nlp::kInf, 0.9);
   const int y = nlp.add_variables(1, 0.0, fesd::nlp::kInf, 0.2);
   nlp.add_objective(fesd::nlp::make_block(DistanceTo{1.0}), {x, y});
   const std::vector<fesd::mpcc::CompPair> pairs{{x, y}};
-  const std::vector<fesd::mpcc::CompGroup> groups{fesd::mpcc::CompGroup{pairs}};
-  const fesd::mpcc::Relaxation relaxation(nlp, groups, GetParam());
-  EXPECT_EQ(relaxation.mode(), GetParam());
-  nlp.finalize();
+  problem.add_complementarity({fesd::mpcc::CompGroup{pairs}}, pairs);
+  problem.relax(GetParam());
+  EXPECT_EQ(problem.mpcc_mode(), GetParam());
+  problem.finalize();
 
-  fesd::nlp::IpoptSolver solver(fesd::NlpOptions{});
-  fesd::nlp::Iterate it;
-  it.x = nlp.x_init;
+  const auto solver = fesd::nlp::make_solver(fesd::NlpOptions{});
   int rows_seen = 0;
   // Not sigma_0 = 1: the first relaxed NLP would then have its solution on the problem's axis of
   // symmetry x = y ((1, 1) for the Scholtes and Fischer-Burmeister relaxations, (2/3, 2/3) for
@@ -67,17 +66,17 @@ TEST_P(TinyMpcc, ReachesTheLocalMinimizerOfTheStart) {
   // decides between (1, 0) and (0, 1). From sigma_0 = 0.1 every mode keeps the start's side.
   fesd::HomotopyOptions options;
   options.sigma_0 = 0.1;
-  const auto res = fesd::mpcc::solve_homotopy(nlp, relaxation, pairs, solver, it, options,
-                                              [&](const fesd::HomotopyRow& r) {
-                                                EXPECT_EQ(r.k, rows_seen);
-                                                ++rows_seen;
-                                              });
+  const auto res = problem.solve_homotopy(*solver, options, [&](const fesd::HomotopyRow& r) {
+    EXPECT_EQ(r.k, rows_seen);
+    ++rows_seen;
+  });
   ASSERT_EQ(res.status, fesd::Status::Success) << res.last_nlp_status;
   EXPECT_EQ(rows_seen, static_cast<int>(res.rows.size()));
   EXPECT_LE(res.comp_residual, options.complementarity_tol);
-  EXPECT_NEAR(it.x[x], 1.0, 1e-6);
-  EXPECT_NEAR(it.x[y], 0.0, 1e-6);
-  const double f = (it.x[x] - 1) * (it.x[x] - 1) + (it.x[y] - 1) * (it.x[y] - 1);
+  const std::vector<double>& w = problem.solution();
+  EXPECT_NEAR(w[x], 1.0, 1e-6);
+  EXPECT_NEAR(w[y], 0.0, 1e-6);
+  const double f = (w[x] - 1) * (w[x] - 1) + (w[y] - 1) * (w[y] - 1);
   EXPECT_NEAR(f, 1.0, 1e-6);
 }
 INSTANTIATE_TEST_SUITE_P(Modes, TinyMpcc, ::testing::ValuesIn(kAllModes), mode_name);
@@ -91,39 +90,36 @@ class RecordingSolver : public fesd::nlp::NlpSolver {
                              bool warm_start, double tol, int max_iter) override {
     tols.push_back(tol);
     max_iters.push_back(max_iter);
-    return inner_.solve(nlp, start, warm_start, tol, max_iter);
+    return inner_->solve(nlp, start, warm_start, tol, max_iter);
   }
   std::vector<double> tols;
   std::vector<int> max_iters;
 
  private:
-  fesd::nlp::IpoptSolver inner_{fesd::NlpOptions{}};
+  std::unique_ptr<fesd::nlp::NlpSolver> inner_ = fesd::nlp::make_solver(fesd::NlpOptions{});
 };
 
 struct TinyProblem {
-  fesd::nlp::BlockNlp nlp;
+  fesd::mpcc::Problem problem;
   int x = 0, y = 0;
-  std::vector<fesd::mpcc::CompPair> pairs;
-  std::unique_ptr<fesd::mpcc::Relaxation> relaxation;
   explicit TinyProblem(double a) {
+    fesd::nlp::BlockNlp& nlp = problem.nlp();
     x = nlp.add_variables(1, 0.0, fesd::nlp::kInf, 0.9);
     y = nlp.add_variables(1, 0.0, fesd::nlp::kInf, 0.2);
     nlp.add_objective(fesd::nlp::make_block(DistanceTo{a}), {x, y});
-    pairs = {{x, y}};
-    relaxation = std::make_unique<fesd::mpcc::Relaxation>(
-        nlp, std::vector<fesd::mpcc::CompGroup>{fesd::mpcc::CompGroup{pairs}},
-        MpccMode::ScholtesIneq);
-    nlp.finalize();
+    const std::vector<fesd::mpcc::CompPair> pairs{{x, y}};
+    problem.add_complementarity({fesd::mpcc::CompGroup{pairs}}, pairs);
+    problem.relax(MpccMode::ScholtesIneq);
+    problem.finalize();
   }
   /// The homotopy sigma = 0.1, 0.01, ... with intermediate_tol 1e-6, from (0.9, 0.2).
   fesd::mpcc::HomotopyResult solve(RecordingSolver& solver) {
-    it.x = nlp.x_init;
     fesd::HomotopyOptions options;
     options.sigma_0 = 0.1;
     options.intermediate_tol = 1e-6;
-    return fesd::mpcc::solve_homotopy(nlp, *relaxation, pairs, solver, it, options);
+    return problem.solve_homotopy(solver, options);
   }
-  fesd::nlp::Iterate it;
+  double at(int var) const { return problem.solution()[var]; }
 };
 
 // sigma = 0.1, 0.01, ..., 1e-9 with complementarity_tol 1e-9: the NLPs with sigma > 1e-8 get
@@ -137,8 +133,8 @@ TEST(IntermediateTol, EarlyNlpsLooseLastNlpsTight) {
   for (std::size_t k = 0; k < 7; ++k) EXPECT_EQ(solver.tols[k], 1e-6) << "NLP " << k;
   EXPECT_EQ(solver.tols[7], 0.0);
   EXPECT_EQ(solver.tols[8], 0.0);
-  EXPECT_NEAR(p.it.x[p.x], 1.0, 1e-6);
-  EXPECT_NEAR(p.it.x[p.y], 0.0, 1e-6);
+  EXPECT_NEAR(p.at(p.x), 1.0, 1e-6);
+  EXPECT_NEAR(p.at(p.y), 0.0, 1e-6);
 }
 
 // min (x - 1)^2 + (y + 1)^2, 0 <= x _|_ y >= 0: the solution (1, 0) has no active product, so the
@@ -154,53 +150,55 @@ TEST(IntermediateTol, ToleranceMetLooselyIsSolvedAgainTight) {
   EXPECT_EQ(solver.tols[1], 0.0);
   ASSERT_EQ(res.rows.size(), 2u);
   EXPECT_EQ(res.rows[0].sigma, res.rows[1].sigma);
-  EXPECT_NEAR(p.it.x[p.x], 1.0, 1e-8);
-  EXPECT_NEAR(p.it.x[p.y], 0.0, 1e-8);
+  EXPECT_NEAR(p.at(p.x), 1.0, 1e-8);
+  EXPECT_NEAR(p.at(p.y), 0.0, 1e-8);
 }
 
 // ---- solve_again (pinned sliding exits) --------------------------------------------------------
 
-// After the homotopy (solution (1, 0)): bounds changed by the callback for one more NLP at the
-// last sigma, then restored. A feasible change gives its solution; an infeasible one (x = 2 and
-// y >= 1, so x y >= 2 > sigma) leaves the point as it was.
+// After the homotopy (solution (1, 0)): bounds changed for one more NLP at the last sigma, then
+// restored. A feasible change gives its solution; an infeasible one (x = 2 and y >= 1, so
+// x y >= 2 > sigma) leaves the point as it was.
 TEST(SolveAgain, ChangesBoundsForOneNlpAndKeepsThePointIfItFails) {
   TinyProblem p(1.0);
   RecordingSolver solver;
   const auto res = p.solve(solver);
   ASSERT_EQ(res.status, fesd::Status::Success) << res.last_nlp_status;
   const double sigma = res.rows.back().sigma;
-  const std::vector<double> lb = p.nlp.x_lb, ub = p.nlp.x_ub;
+  const int k_next = static_cast<int>(res.rows.size());
+  std::vector<double> lb, ub;
+  for (int v : {p.x, p.y}) {
+    lb.push_back(p.problem.lower(v));
+    ub.push_back(p.problem.upper(v));
+  }
+  auto bounds_kept = [&] {
+    EXPECT_EQ(p.problem.lower(p.x), lb[0]);
+    EXPECT_EQ(p.problem.lower(p.y), lb[1]);
+    EXPECT_EQ(p.problem.upper(p.x), ub[0]);
+    EXPECT_EQ(p.problem.upper(p.y), ub[1]);
+  };
   fesd::HomotopyOptions options;
 
-  const auto capped =
-      fesd::mpcc::solve_again(p.nlp, *p.relaxation, p.pairs, solver, p.it, sigma, 9, options,
-                              [&](fesd::nlp::BlockNlp& nlp, std::vector<double>& x) {
-                                nlp.x_ub[p.x] = 0.5;
-                                x[p.x] = 0.5;
-                              });
+  const auto capped = p.problem.solve_again(solver, options, {{p.x, 0.0, 0.5}}, 1);
   ASSERT_EQ(capped.status, fesd::Status::Success) << capped.last_nlp_status;
   ASSERT_EQ(capped.rows.size(), 1u);
-  EXPECT_EQ(capped.rows[0].k, 9);
-  EXPECT_EQ(capped.rows[0].sigma, sigma);
+  EXPECT_EQ(capped.rows[0].k, k_next);
+  EXPECT_EQ(capped.rows[0].sigma, sigma);  // sigma stays inside the problem
+  EXPECT_EQ(capped.rows[0].pinned_exits, 1);
   EXPECT_EQ(solver.tols.back(), 0.0);  // the configured tolerance
   EXPECT_EQ(solver.max_iters.back(), fesd::mpcc::kSolveAgainMaxIter);
   EXPECT_EQ(solver.max_iters.front(), 0);  // the homotopy's NLPs: the configured limit
-  EXPECT_NEAR(p.it.x[p.x], 0.5, 1e-8);
-  EXPECT_NEAR(p.it.x[p.y], 0.0, 1e-8);
-  EXPECT_EQ(p.nlp.x_lb, lb);
-  EXPECT_EQ(p.nlp.x_ub, ub);
+  EXPECT_NEAR(p.at(p.x), 0.5, 1e-8);
+  EXPECT_NEAR(p.at(p.y), 0.0, 1e-8);
+  bounds_kept();
 
-  const std::vector<double> before = p.it.x;
+  const std::vector<double> before = p.problem.solution();
   const auto infeasible =
-      fesd::mpcc::solve_again(p.nlp, *p.relaxation, p.pairs, solver, p.it, sigma, 10, options,
-                              [&](fesd::nlp::BlockNlp& nlp, std::vector<double>&) {
-                                nlp.x_lb[p.x] = nlp.x_ub[p.x] = 2.0;
-                                nlp.x_lb[p.y] = 1.0;
-                              });
+      p.problem.solve_again(solver, options, {{p.x, 2.0, 2.0}, {p.y, 1.0, fesd::nlp::kInf}});
   EXPECT_NE(infeasible.status, fesd::Status::Success);
-  EXPECT_EQ(p.it.x, before);
-  EXPECT_EQ(p.nlp.x_lb, lb);
-  EXPECT_EQ(p.nlp.x_ub, ub);
+  EXPECT_EQ(infeasible.rows[0].k, k_next + 1);
+  EXPECT_EQ(p.problem.solution(), before);
+  bounds_kept();
 }
 
 // ---- Example 3(a) through the integrator ------------------------------------------------------

@@ -12,7 +12,7 @@
 
 #include "discretization/fesd_interval.hpp"
 #include "fesd/model.hpp"
-#include "mpcc/homotopy.hpp"
+#include "mpcc/relaxation.hpp"
 #include "support/compare.hpp"
 
 namespace {
@@ -54,7 +54,9 @@ TEST_P(DerivativesTest, MatchCentralDifferences) {
   const Case c = GetParam();
   const fesd::Pss model = fesd::make_pss(
       Nonlinear{},
-      fesd::PssDims{.n_x = 2, .n_u = 1, .n_p = 1,
+      fesd::PssDims{.n_x = 2,
+                    .n_u = 1,
+                    .n_p = 1,
                     .subsystems = {fesd::Subsystem::from_c(1), fesd::Subsystem::from_c(2)}});
   fesd::DiscretizationOptions d;
   d.rk_scheme = c.scheme;

@@ -36,8 +36,8 @@ TEST(SlidingModeOcp, SwitchingSequenceOfSection53AndPiecewiseUniformGrid) {
   // The exit from the co-dimension-2 set lies inside control interval 3: pinned (theta of the
   // region left = 0 at the element end) and solved once more. The exit from phi_1 = 0 is on the
   // control-interval boundary t = 8/3, where exits are not pinned.
-  EXPECT_EQ(r.pinned_exits, 1);
-  EXPECT_FALSE(r.pin_failed);
+  EXPECT_EQ(r.summary.pinned_exits, 1);
+  EXPECT_EQ(r.summary.pin_failures, 0);
   EXPECT_NEAR(r.switches[3].t, 8.0 / 3.0, 1e-9);
   // Step equilibration: inside a control interval h changes only where the active set does
   // (Fig. 12, middle). Tolerance 1e-6 of h0 = 1/9: the NLP is solved to 1e-12 but the penalty

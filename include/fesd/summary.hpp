@@ -1,0 +1,104 @@
+// include/fesd/summary.hpp: what a solve did and what it cost, in one vocabulary for the
+// integrator (integrator.hpp) and the optimal control solver (ocp.hpp): one row per NLP of the
+// MPCC homotopy (Sect. 5.2 of papers/fesd-filippov.txt), the switches found, the work and time
+// summary, the progress callbacks, and the one formatter of each of them.
+//
+// Regions are numbered from 0 everywhere (reports, JSON, plots, C++): region r of a model is row r
+// of its sign matrix S (13), or of the Cartesian product's stacked regions (21).
+#pragma once
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "fesd/status.hpp"
+
+namespace fesd {
+
+/// One NLP of a homotopy (one row of the progress table).
+struct HomotopyRow {
+  int k = 0;                 ///< homotopy iteration
+  double sigma = 0;          ///< relaxation parameter
+  double comp_residual = 0;  ///< largest complementarity product after the solve
+  double objective = 0;      ///< the NLP's objective (penalty terms of the MPCC method included)
+  double inf_pr = 0;         ///< IPOPT's final primal infeasibility
+  int nlp_iterations = 0;
+  std::string nlp_status;  ///< IPOPT's return status, e.g. "Solve_Succeeded"
+  double cpu_s = 0;
+  /// KKT solver IPOPT used: "dense" (LAPACK LDL', small NLPs) or "mumps".
+  std::string linear_solver;
+  /// > 0: not a homotopy step but the last NLP solved once more with this many sliding exits
+  /// pinned (DiscretizationOptions::pin_sliding_exits).
+  int pinned_exits = 0;
+};
+
+/// A detected switch: the active set changes at an element boundary.
+struct SwitchEvent {
+  double t = 0;             ///< switching time t_s = boundary between the two elements
+  int element = 0;          ///< global index of the element that ends at t
+  std::vector<int> before;  ///< active regions (0-based region indices) before t
+  std::vector<int> after;   ///< active regions after t
+};
+
+/// Work and time of a whole run (an integration or an OCP solve).
+struct Summary {
+  int homotopy_steps = 0;        ///< NLPs solved, re-solves included
+  int nlp_iterations = 0;        ///< IPOPT iterations, all NLPs
+  double wall_s = 0;             ///< total wall time
+  double derivative_s = 0;       ///< time in fesd's function and derivative evaluations
+  double solver_s = 0;           ///< time inside IPOPT (incl. MUMPS), excluding the evaluations
+  double setup_s = 0;            ///< building the NLP (patterns, index maps)
+  double max_comp_residual = 0;  ///< largest final complementarity residual (over the steps)
+  int n_variables = 0;           ///< size of the NLP (the first step's, for the integrator)
+  int n_constraints = 0;
+
+  // ---- integrator only: the retry policy of integrate() ----
+  /// Steps whose homotopy failed with the chosen cross_comp_mode and were solved again with the
+  /// sparse form (28) from the same start (their rows follow in the step's homotopy).
+  int fallback_steps = 0;
+  /// Steps that failed in both forms and were solved again with 2 N_FE finite elements (two
+  /// switches closer together than a step need two free element boundaries between them); such
+  /// a step has 2 N_FE elements in the grid. refine_attempts counts the tries, refined_steps the
+  /// successes; every try follows a failed attempt in the result's homotopy list.
+  int refine_attempts = 0;
+  int refined_steps = 0;
+  /// Steps that failed also with 2 N_FE elements and were replaced by two half steps (recursively,
+  /// at most twice: quarter steps). Each half step has N_FE elements of its own, so the grid then
+  /// has more than N_sim * N_FE elements.
+  int split_steps = 0;
+
+  // ---- pinned sliding exits (DiscretizationOptions::pin_sliding_exits) ----
+  /// Exits at an element boundary where the leaving region's theta was still > 1e-6, each moved
+  /// to where it reaches 0 by solving the last NLP once more (a row with pinned_exits > 0).
+  int pinned_exits = 0;
+  /// Re-solves with pinned exits that failed; those solutions stay unpinned.
+  int pin_failures = 0;
+};
+
+/// Progress of the integrator: one call per integration step (all its attempts included).
+struct StepProgress {
+  int step = 0;   ///< 1-based
+  int N_sim = 0;  ///< steps in all
+  double t = 0;   ///< time reached
+  int nlps = 0;   ///< NLPs of the step's last attempt
+  int nlp_iterations = 0;
+  double comp_residual = 0;
+  Status status = Status::NotRun;  ///< of the step's last attempt
+};
+using StepCallback = std::function<void(const StepProgress&)>;
+/// Progress of a homotopy: one call per NLP solved (the OCP; re-solves included).
+using HomotopyCallback = std::function<void(const HomotopyRow&)>;
+
+/// "    t_s = 1.5   active regions {0,2} -> {0,1,2}\n"
+std::string format_switch(const SwitchEvent& s);
+/// The header line of the homotopy table ("   k     sigma       comp ...\n").
+std::string homotopy_table_header();
+/// One row of the homotopy table, aligned with homotopy_table_header() (a pinned re-solve is
+/// marked as such).
+std::string format_homotopy_row(const HomotopyRow& r);
+/// "  step   12/40  t = 0.3  NLPs  5  iter   45  comp 1.2e-12  success\n"
+std::string format_step_progress(const StepProgress& p);
+/// The work and time lines every full report ends with: NLPs, iterations, pinned exits, wall
+/// time split into derivatives, IPOPT + MUMPS and setup. `per_step` > 0 adds per-step figures.
+std::string format_work(const Summary& s, double per_step = 0);
+
+}  // namespace fesd

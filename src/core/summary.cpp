@@ -1,0 +1,71 @@
+// The formatters of include/fesd/summary.hpp: the one place where homotopy rows, switches, step
+// progress and the work/time split are turned into text.
+#include "fesd/summary.hpp"
+
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+namespace fesd {
+
+std::string format_switch(const SwitchEvent& s) {
+  return fmt::format("    t_s = {:.12g}   active regions {{{}}} -> {{{}}}\n", s.t,
+                     fmt::join(s.before, ","), fmt::join(s.after, ","));
+}
+
+std::string homotopy_table_header() {
+  return fmt::format("{:>4} {:>9} {:>10} {:>14} {:>9} {:>5}  {:<26} {:>8}\n", "k", "sigma", "comp",
+                     "objective", "inf_pr", "iter", "IPOPT status", "time s");
+}
+
+std::string format_homotopy_row(const HomotopyRow& r) {
+  std::string row = fmt::format(
+      "{:>4} {:>9.1e} {:>10.2e} {:>14.7e} {:>9.1e} {:>5}  {:<26} {:>8.3f}", r.k, r.sigma,
+      r.comp_residual, r.objective, r.inf_pr, r.nlp_iterations, r.nlp_status, r.cpu_s);
+  if (r.pinned_exits > 0)
+    row += fmt::format("  (the last NLP again, {} sliding exit{} pinned)", r.pinned_exits,
+                       r.pinned_exits == 1 ? "" : "s");
+  return row + "\n";
+}
+
+std::string format_step_progress(const StepProgress& p) {
+  return fmt::format("  step {:>4}/{}  t = {:<10.6g}  NLPs {:>2}  iter {:>4}  comp {:.1e}  {}\n",
+                     p.step, p.N_sim, p.t, p.nlps, p.nlp_iterations, p.comp_residual,
+                     to_string(p.status));
+}
+
+std::string format_work(const Summary& s, double per_step) {
+  std::string out;
+  auto per = [&](double v, const char* unit) {
+    return per_step > 0 ? fmt::format("  ({:.1f} per {})", v / per_step, unit) : std::string();
+  };
+  out +=
+      fmt::format("  NLPs solved          {}{}\n", s.homotopy_steps, per(s.homotopy_steps, "step"));
+  out +=
+      fmt::format("  IPOPT iterations     {}{}\n", s.nlp_iterations, per(s.nlp_iterations, "step"));
+  out += fmt::format("  max comp. residual   {:.2e}\n", s.max_comp_residual);
+  if (s.fallback_steps > 0)
+    out += fmt::format("  retried steps        {}  (sparse cross complementarity (28))\n",
+                       s.fallback_steps);
+  if (s.refined_steps > 0)
+    out += fmt::format("  refined steps        {}  (solved again with 2 N_FE elements)\n",
+                       s.refined_steps);
+  if (s.split_steps > 0)
+    out += fmt::format("  split steps          {}  (retried as two half steps)\n", s.split_steps);
+  if (s.pinned_exits > 0 || s.pin_failures > 0)
+    out += fmt::format("  pinned sliding exits {}  ({} re-solve{} failed, unpinned)\n",
+                       s.pinned_exits, s.pin_failures, s.pin_failures == 1 ? "" : "s");
+  out += fmt::format("  wall time            {:.3f} s", s.wall_s);
+  out += per_step > 0 ? fmt::format("  ({:.2f} ms per step)\n", 1e3 * s.wall_s / per_step) : "\n";
+  const double busy = s.derivative_s + s.solver_s;
+  out += fmt::format("    derivatives        {:.3f} s  ({:.0f} %)\n", s.derivative_s,
+                     busy > 0 ? 100 * s.derivative_s / busy : 0.0);
+  out += fmt::format("    IPOPT + MUMPS      {:.3f} s  ({:.0f} %)\n", s.solver_s,
+                     busy > 0 ? 100 * s.solver_s / busy : 0.0);
+  out += fmt::format("    setup              {:.3f} s\n", s.setup_s);
+  return out;
+}
+
+}  // namespace fesd

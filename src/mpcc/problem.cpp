@@ -1,0 +1,186 @@
+// src/mpcc/problem.cpp: the MPCC problem object and its homotopy (problem.hpp).
+#include "mpcc/problem.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "fesd/error.hpp"
+
+namespace fesd::mpcc {
+
+namespace {
+// NLPs with sigma <= this factor times complementarity_tol are solved with the configured tol
+// (with a margin for the round-off of sigma_k = slope^k sigma_0: 0.1^8 is 1.0000000000000005e-8).
+constexpr double kTightSigmaFactor = 10.0 * (1.0 + 1e-9);
+
+// Adds the row of one NLP solve (k, sigma) to res and its times and iterations to the totals.
+void record(HomotopyResult& res, const nlp::NlpResult& r, int k, double sigma) {
+  // r.objective is the NLP's objective: for ell_1_penalty and elastic_ineq it includes the
+  // penalty term (1 / sigma) * (sum of groups, or s).
+  HomotopyRow row;
+  row.k = k;
+  row.sigma = sigma;
+  row.comp_residual = res.comp_residual;
+  row.objective = r.objective;
+  row.inf_pr = r.inf_pr;
+  row.nlp_iterations = r.iterations;
+  row.nlp_status = r.status;
+  row.cpu_s = r.total_s;
+  row.linear_solver = r.linear_solver;
+  res.rows.push_back(std::move(row));
+  res.eval_s += r.eval_s;
+  res.solver_s += r.total_s - r.eval_s;
+  res.nlp_iterations += r.iterations;
+  res.last_nlp_status = r.status;
+}
+
+// Sets sigma in the NLP, and in the point's fixed sigma variable (fischer_burmeister): IPOPT takes
+// a fixed variable's value from its bounds anyway; set it so the point itself is consistent (for
+// other NlpSolver backends, and in the solution).
+void apply_sigma(const Relaxation& relaxation, nlp::BlockNlp& nlp, nlp::Iterate& it, double sigma) {
+  relaxation.set_sigma(nlp, sigma);
+  if (const int v = relaxation.sigma_variable(); v >= 0 && v < static_cast<int>(it.x.size()))
+    it.x[v] = sigma;
+}
+
+Status final_status(bool nlp_ok, bool eval_failed, double comp, double comp_tol) {
+  if (nlp_ok && comp <= comp_tol) return Status::Success;
+  if (!nlp_ok) return eval_failed ? Status::EvaluationFailed : Status::NlpFailed;
+  return Status::ComplementarityNotMet;
+}
+
+// Number of NLPs of an automatic homotopy: until sigma reaches sigma_N.
+int homotopy_length(const HomotopyOptions& o) {
+  if (o.max_homotopy_steps > 0) return o.max_homotopy_steps;
+  return 1 + static_cast<int>(std::ceil(
+                 std::log(o.sigma_N / o.sigma_0) / std::log(o.homotopy_update_slope) - 1e-9));
+}
+}  // namespace
+
+double comp_residual(const double* x, const std::vector<CompPair>& pairs) {
+  double r = 0.0;
+  for (const CompPair& p : pairs) r = std::max(r, std::abs(x[p.a] * x[p.b]));
+  return r;
+}
+
+// ---- description ------------------------------------------------------------------------------
+
+nlp::BlockNlp& Problem::nlp() {
+  if (relaxation_) throw InternalError("mpcc::Problem::nlp(): the problem is already relaxed");
+  return nlp_;
+}
+
+void Problem::add_complementarity(const std::vector<CompGroup>& groups,
+                                  const std::vector<CompPair>& residual_pairs) {
+  if (relaxation_)
+    throw InternalError("mpcc::Problem::add_complementarity(): the problem is already relaxed");
+  groups_.insert(groups_.end(), groups.begin(), groups.end());
+  residual_pairs_.insert(residual_pairs_.end(), residual_pairs.begin(), residual_pairs.end());
+}
+
+void Problem::relax(MpccMode mode) {
+  if (relaxation_) throw InternalError("mpcc::Problem::relax(): called twice");
+  relaxation_.emplace(nlp_, groups_, mode);
+}
+
+void Problem::finalize() {
+  if (!relaxation_ || finalized())
+    throw InternalError("mpcc::Problem::finalize(): needs relax() before, and only once");
+  nlp_.finalize();
+}
+
+// ---- workspace --------------------------------------------------------------------------------
+
+void Problem::fix(const std::vector<int>& vars, const Eigen::VectorXd& values) {
+  for (std::size_t i = 0; i < vars.size(); ++i) {
+    const double v = values[static_cast<Eigen::Index>(i)];
+    nlp_.x_lb[vars[i]] = nlp_.x_ub[vars[i]] = nlp_.x_init[vars[i]] = v;
+  }
+}
+
+void Problem::bound(int var, double lb, double ub) {
+  nlp_.x_lb[var] = lb;
+  nlp_.x_ub[var] = ub;
+}
+
+void Problem::set_guess(const std::vector<int>& vars, const Eigen::VectorXd& values) {
+  for (std::size_t i = 0; i < vars.size(); ++i)
+    nlp_.x_init[vars[i]] = values[static_cast<Eigen::Index>(i)];
+}
+
+void Problem::copy_inputs_from(const Problem& other) {
+  if (other.nlp_.num_variables() != nlp_.num_variables())
+    throw InternalError("mpcc::Problem::copy_inputs_from(): different variables");
+  nlp_.x_lb = other.nlp_.x_lb;
+  nlp_.x_ub = other.nlp_.x_ub;
+  nlp_.x_init = other.nlp_.x_init;
+}
+
+// ---- solving ----------------------------------------------------------------------------------
+
+HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOptions& o,
+                                       const HomotopyCallback& on_row) {
+  if (!finalized()) throw InternalError("mpcc::Problem::solve_homotopy(): not finalized");
+  HomotopyResult res;
+  it_ = nlp::Iterate{};
+  it_.x = nlp_.x_init;
+  double sigma = o.sigma_0;
+  bool last_ok = false, eval_failed = false;
+  bool tight_now = false;  // solve the next NLP with the configured tolerance
+  const int max_steps = homotopy_length(o);
+  // One NLP more than max_steps if the last one met the tolerance only loosely (below).
+  for (int k = 0; k < max_steps + (tight_now ? 1 : 0); ++k) {
+    apply_sigma(*relaxation_, nlp_, it_, sigma);
+    // NLPs far from the end of the homotopy only need to be good starting points for the next
+    // one: with intermediate_tol they stop earlier. The NLPs with sigma near
+    // complementarity_tol, and the last, use the configured tolerance.
+    const bool loose = !tight_now && o.intermediate_tol > 0 &&
+                       sigma > kTightSigmaFactor * o.complementarity_tol && sigma > o.sigma_N;
+    const nlp::NlpResult r =
+        solver.solve(nlp_, it_, /*warm_start=*/k > 0, loose ? o.intermediate_tol : 0.0, 0);
+    res.comp_residual = comp_residual(it_.x.data(), residual_pairs_);
+    record(res, r, k, sigma);
+    if (on_row) on_row(res.rows.back());
+    sigma_ = sigma;
+    last_ok = r.success;
+    eval_failed = r.eval_error;
+    if (last_ok && res.comp_residual <= o.complementarity_tol) {
+      if (!loose) break;
+      // Complementarity already met by a loosely solved NLP: solve it again at this sigma with
+      // the configured tolerance (warm; usually a few iterations) before stopping.
+      tight_now = true;
+      continue;
+    }
+    if (sigma <= o.sigma_N) break;  // sigma cannot get smaller: another NLP would repeat this one
+    sigma = std::max(o.homotopy_update_slope * sigma, o.sigma_N);
+  }
+  next_row_ = static_cast<int>(res.rows.size());
+  res.status = final_status(last_ok, eval_failed, res.comp_residual, o.complementarity_tol);
+  return res;
+}
+
+HomotopyResult Problem::solve_again(nlp::NlpSolver& solver, const HomotopyOptions& o,
+                                    const std::vector<nlp::Bound>& changes, int pinned_exits) {
+  if (it_.x.empty()) throw InternalError("mpcc::Problem::solve_again(): no homotopy before");
+  HomotopyResult res;
+  const std::vector<double> x_lb = nlp_.x_lb, x_ub = nlp_.x_ub;
+  nlp::Iterate trial = it_;
+  for (const nlp::Bound& c : changes) {
+    nlp_.x_lb[c.var] = c.lb;
+    nlp_.x_ub[c.var] = c.ub;
+    trial.x[c.var] = std::clamp(trial.x[c.var], c.lb, c.ub);
+  }
+  apply_sigma(*relaxation_, nlp_, trial, sigma_);
+  const nlp::NlpResult r = solver.solve(nlp_, trial, /*warm_start=*/true, 0.0, kSolveAgainMaxIter);
+  nlp_.x_lb = x_lb;
+  nlp_.x_ub = x_ub;
+  res.comp_residual = comp_residual(trial.x.data(), residual_pairs_);
+  record(res, r, next_row_++, sigma_);
+  res.rows.back().pinned_exits = pinned_exits;
+  res.status = final_status(r.success, r.eval_error, res.comp_residual, o.complementarity_tol);
+  if (res.status == Status::Success) it_ = std::move(trial);
+  return res;
+}
+
+}  // namespace fesd::mpcc
