@@ -142,7 +142,8 @@ void check_input(const Pss& model, const Eigen::VectorXd& x0, double T_sim, int 
 class Integrator {
  public:
   Integrator(const Pss& model, const Eigen::VectorXd& x0, double T_sim, int N_sim,
-             const IntegratorOptions& options, Eigen::VectorXd u, Eigen::VectorXd p)
+             const IntegratorOptions& options, Eigen::VectorXd u, Eigen::VectorXd p,
+             Clock::time_point t_start)
       : model_(model),
         options_(options),
         d_(options.discretization),
@@ -160,6 +161,7 @@ class Integrator {
     first.mpcc.finalize();
     res_.summary.n_variables = first.mpcc.num_variables();
     res_.summary.n_constraints = first.mpcc.num_constraints();
+    res_.summary.setup_s = seconds_since(t_start);
     solver_ = nlp::make_solver(options_.nlp);
     res_.t.push_back(0.0);
     res_.x.push_back(x0);
@@ -461,13 +463,10 @@ IntegratorResult integrate(const Pss& model, const Eigen::VectorXd& x0, double T
   const Eigen::VectorXd u = u_in.size() == 0 ? Eigen::VectorXd::Zero(model.n_u()) : u_in;
   const Eigen::VectorXd p = p_in.size() == 0 ? model.p_default : p_in;
   check_input(model, x0, T_sim, N_sim, options, u, p);
-  Integrator run(model, x0, T_sim, N_sim, options, u, p);
-  const double setup_s = seconds_since(t_start);
+  Integrator run(model, x0, T_sim, N_sim, options, u, p, t_start);
   for (int step = 0; step < N_sim; ++step)
     if (!run.step(step)) break;
-  IntegratorResult res = run.finish(seconds_since(t_start));
-  res.summary.setup_s = setup_s;
-  return res;
+  return run.finish(seconds_since(t_start));
 }
 
 std::string IntegratorResult::brief_report() const {
