@@ -149,8 +149,9 @@ struct OcpResult {
   Eigen::VectorXd x_final() const { return x.empty() ? Eigen::VectorXd() : x.back(); }
   /// One line: status, objective, x(0), number of switches, time.
   std::string brief_report() const;
-  /// A multi-line human summary (status, objective, switches, homotopy table, work and timing).
-  std::string full_report() const;
+  /// A multi-line human summary: status, objective, switches, the homotopy table (unless
+  /// with_homotopy_table is false, e.g. when it was already shown as progress), work and timing.
+  std::string full_report(bool with_homotopy_table = true) const;
 };
 
 /// Solves the OCP. Throws fesd::InvalidModel / InvalidOption for bad input (dimensions, NaN,

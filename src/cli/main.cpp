@@ -511,8 +511,9 @@ int run_simulate(const SolveArgs& args, const CLI::App& cmd) {
 int run_solve(const SolveArgs& args, const CLI::App& cmd) {
   const auto problem = prepare<fesd::OcpProblem>(args, cmd);
   const fesd::OcpResult result = fesd::solve(problem.ocp, problem.options);
-  return finish(result, result.full_report(), problem.ocp.model, problem.name, args, cmd,
-                "optimal control problem");
+  // The homotopy table is the progress output (none with --quiet): not repeated in the report.
+  return finish(result, result.full_report(/*with_homotopy_table=*/false), problem.ocp.model,
+                problem.name, args, cmd, "optimal control problem");
 }
 
 /// Adds FILE, the output options and --quiet to `simulate` or `solve`.

@@ -573,7 +573,7 @@ std::string OcpResult::brief_report() const {
       summary.homotopy_steps, summary.nlp_iterations, summary.wall_s);
 }
 
-std::string OcpResult::full_report() const {
+std::string OcpResult::full_report(bool with_homotopy_table) const {
   std::ostringstream os;
   auto vec = [](const Eigen::VectorXd& v) {
     std::string s;
@@ -593,8 +593,10 @@ std::string OcpResult::full_report() const {
   for (const auto& s : switches) os << format_switch(s);
   os << fmt::format("  NLP size             {} variables, {} constraints\n", summary.n_variables,
                     summary.n_constraints);
-  os << "  homotopy\n" << homotopy_table_header();
-  for (const auto& r : homotopy) os << format_homotopy_row(r);
+  if (with_homotopy_table) {
+    os << "  homotopy\n" << homotopy_table_header();
+    for (const auto& r : homotopy) os << format_homotopy_row(r);
+  }
   os << format_work(summary);
   return os.str();
 }

@@ -289,6 +289,9 @@ TEST(CliSolve, SolvesAndWritesRequestedOutputs) {
   EXPECT_TRUE(contains(r.out, "fesd optimal control: success")) << r.out;
   EXPECT_TRUE(contains(r.out, json)) << r.out;
   EXPECT_TRUE(contains(r.err, "sigma")) << "progress lines on stderr: " << r.err;
+  // The homotopy table appears once: as progress, not again in the report.
+  EXPECT_TRUE(contains(r.err, "IPOPT status")) << r.err;
+  EXPECT_FALSE(contains(r.out, "IPOPT status")) << r.out;
 
   const nlohmann::json j = nlohmann::json::parse(read_file(json));
   for (const char* key : {"status", "message", "objective", "t", "x", "t_ctrl", "u", "h",
