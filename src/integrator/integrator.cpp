@@ -15,6 +15,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "core/limits.hpp"
 #include "core/report.hpp"
 #include "dcs/stewart.hpp"
 #include "discretization/fesd_interval.hpp"
@@ -158,6 +159,11 @@ IntegratorResult integrate(const Pss& model, const Eigen::VectorXd& x0_in, doubl
   if (!std::isfinite(T_sim) || T_sim <= 0)
     throw InvalidOption(fmt::format("T_sim = {}: must be finite and > 0", T_sim));
   if (N_sim < 1) throw InvalidOption(fmt::format("N_sim = {}: must be >= 1", N_sim));
+  if (std::string e = core::step_length_error("T_sim", T_sim, "N_sim", N_sim); !e.empty())
+    throw InvalidOption(e);
+  if (auto e = discretization::FesdInterval::block_size_errors(model, options.discretization);
+      !e.empty())
+    throw InvalidModel(fmt::format("{}", fmt::join(e, "; ")));
   const Eigen::VectorXd u = u_in.size() == 0 ? Eigen::VectorXd::Zero(model.n_u()) : u_in;
   const Eigen::VectorXd p = p_in.size() == 0 ? model.p_default : p_in;
   if (u.size() != model.n_u())
