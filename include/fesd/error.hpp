@@ -1,15 +1,20 @@
-// include/fesd/error.hpp: exceptions thrown for bad input, before any computation starts.
+// include/fesd/error.hpp: exceptions thrown for bad input, before any computation starts, and the
+// one exception for a bug in fesd itself.
 //
 // What the numerics do (a homotopy that stalls, IPOPT that fails) is never an exception: it is a
-// fesd::Status in the result. Exceptions are for input the caller can fix: wrong sizes, NaN,
-// options out of range, malformed problem files. Every message names the offending field.
+// fesd::Status in the result. fesd::Error and its subclasses are for input the caller can fix:
+// wrong sizes, NaN, options out of range, malformed problem files. Every message names the
+// offending field. fesd::InternalError is not a fesd::Error: it means fesd broke one of its own
+// invariants, whatever the input was (please report it). Running out of memory is std::bad_alloc.
+// The `fesd` program maps them to exit codes: Error 2 (IoError 3), InternalError and
+// std::bad_alloc 4 ("internal error: ...").
 #pragma once
 #include <stdexcept>
 #include <string>
 
 namespace fesd {
 
-/// Base class of every exception fesd throws.
+/// Base class of every exception fesd throws for bad input (everything but InternalError).
 class Error : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
@@ -40,16 +45,17 @@ class ExpressionError : public Error {
   using Error::Error;
 };
 
-/// An internal invariant of fesd failed: a bug, not bad input (CLI exit code 4).
-class InternalError : public Error {
- public:
-  using Error::Error;
-};
-
 /// Writing an output file failed.
 class IoError : public Error {
  public:
   using Error::Error;
+};
+
+/// An internal invariant of fesd is broken (a bug, not bad input): "internal: ...". Deliberately
+/// not a fesd::Error, so that callers who report fesd::Error as "bad input" do not blame the user.
+class InternalError : public std::logic_error {
+ public:
+  using std::logic_error::logic_error;
 };
 
 }  // namespace fesd

@@ -7,14 +7,21 @@
 // `simulate` reads a simulation file ([simulation] table), `solve` an optimal control problem file
 // ([ocp] table), `check` either kind.
 //
-// Exit codes: 0 solved, 1 numerical failure (outputs are still written), 2 bad input, 3 I/O
-// failure, 4 internal error. Every error is one line on stderr: "fesd: error: <message>".
+// Exit codes (kExitHelp below; README.md and docs/problem-files.md list the same):
+//   0  solved (simulate, solve) or valid (check)
+//   1  not converged: the numerical method failed (the outputs are still written)
+//   2  bad input: command line, problem file, option values (fesd::Error)
+//   3  I/O failure: an output file, gnuplot, or standard output (a full disk, a closed pipe)
+//   4  internal error: a bug in fesd (fesd::InternalError) or out of memory (std::bad_alloc)
+// Every error is one line on stderr: "fesd: error: <message>". A closed stdout never kills the
+// program (SIGPIPE is ignored): the --json/--csv/--plot outputs are written, then exit 3.
 #include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -57,6 +64,9 @@ constexpr int kExitSolved = 0;
 constexpr int kExitBadInput = 2;
 constexpr int kExitIo = 3;
 constexpr int kExitInternal = 4;
+constexpr const char* kExitHelp =
+    "Exit codes: 0 solved (check: valid), 1 not converged (outputs still written), 2 bad input, "
+    "3 I/O failure (output files, standard output), 4 internal error (a bug, or out of memory).";
 
 /// Error messages are printed as one line: line breaks become "; ".
 std::string one_line(std::string_view text) {
@@ -74,8 +84,40 @@ std::string one_line(std::string_view text) {
   return out;
 }
 
+// ---- standard output ----------------------------------------------------------------------------
+// Writing to stdout never throws and never kills the program: SIGPIPE is ignored (main), a failed
+// write is remembered, and main() reports it at the end as an I/O error (exit 3), after the
+// outputs asked for with --json/--csv/--plot have been written.
+
+int stdout_errno = 0;  ///< errno of the first failed write to stdout, 0 if none
+
+namespace out {
+/// fmt::print to stdout without exceptions (fmt::print throws when a write fails).
+template <class... Args>
+void print(fmt::format_string<Args...> format, Args&&... args) {
+  const std::string text = fmt::format(format, std::forward<Args>(args)...);
+  errno = 0;
+  if (std::fwrite(text.data(), 1, text.size(), stdout) != text.size() && stdout_errno == 0)
+    stdout_errno = errno != 0 ? errno : EIO;
+}
+}  // namespace out
+
+/// fflush(stdout), remembering why it failed.
+void flush_stdout() {
+  errno = 0;
+  if (std::fflush(stdout) != 0 && stdout_errno == 0) stdout_errno = errno != 0 ? errno : EIO;
+}
+
+/// Flushes stdout; false (and stdout_errno set) if anything written to it was lost.
+bool stdout_ok() {
+  std::cout.flush();
+  flush_stdout();
+  if ((std::ferror(stdout) != 0 || std::cout.fail()) && stdout_errno == 0) stdout_errno = EIO;
+  return stdout_errno == 0;
+}
+
 void print_error(std::string_view message) {
-  std::fflush(stdout);
+  flush_stdout();
   std::cerr << "fesd: error: " << one_line(message) << std::endl;
 }
 
@@ -282,36 +324,36 @@ void print_model_header(const std::string& name, const std::string& source,
         sub.n_c > 0 ? fmt::format("n_c = {}", sub.n_c) : fmt::format("n_g = {}", sub.n_g));
   }
 
-  fmt::print("fesd {}: {} ({})\n", FESD_VERSION, name, source);
-  if (!description.empty()) fmt::print("  {}\n", one_line(description));
-  fmt::print("  model       n_x = {} ({}), n_u = {}, n_p = {}{}\n", m.n_x(), names, m.n_u(),
+  out::print("fesd {}: {} ({})\n", FESD_VERSION, name, source);
+  if (!description.empty()) out::print("  {}\n", one_line(description));
+  out::print("  model       n_x = {} ({}), n_u = {}, n_p = {}{}\n", m.n_x(), names, m.n_u(),
              m.n_p(), has_clock ? ", with clock state t" : "");
-  fmt::print("  regions     {} subsystem{}, regions per subsystem: {} (n_theta = {})\n", m.n_sys(),
+  out::print("  regions     {} subsystem{}, regions per subsystem: {} (n_theta = {})\n", m.n_sys(),
              m.n_sys() == 1 ? "" : "s", regions, m.n_theta());
-  fmt::print("  x0          {}{}\n", join_vector(x0), x0_note);
-  if (p.size() > 0) fmt::print("  p           {}\n", join_vector(p, m.parameter_names));
+  out::print("  x0          {}{}\n", join_vector(x0), x0_note);
+  if (p.size() > 0) out::print("  p           {}\n", join_vector(p, m.parameter_names));
 }
 
 /// The solver lines of the headers: discretization (N_FE as text: a number or a list), homotopy,
 /// IPOPT.
 void print_solver_header(const std::string& n_fe, const fesd::DiscretizationOptions& d,
                          const fesd::HomotopyOptions& h, const fesd::NlpOptions& nlp) {
-  fmt::print("  scheme      {}, n_s = {}, N_FE = {}, use_fesd = {}", fesd::to_string(d.rk_scheme),
+  out::print("  scheme      {}, n_s = {}, N_FE = {}, use_fesd = {}", fesd::to_string(d.rk_scheme),
              d.n_s, n_fe, yes_no(d.use_fesd));
   if (d.use_fesd) {
-    fmt::print(" (cross_comp_mode = {}, step_equilibration = {})", fesd::to_string(d.cross_comp),
+    out::print(" (cross_comp_mode = {}, step_equilibration = {})", fesd::to_string(d.cross_comp),
                fesd::to_string(d.step_eq));
   }
-  fmt::print("\n");
-  fmt::print(
+  out::print("\n");
+  out::print(
       "  homotopy    mpcc_mode = {}, sigma_0 = {:g}, slope = {:g}, sigma_N = {:g}, "
       "complementarity_tol = {:g}, N_homotopy = {}\n",
       fesd::to_string(h.mpcc_mode), h.sigma_0, h.homotopy_update_slope, h.sigma_N,
       h.complementarity_tol, h.max_homotopy_steps);
-  fmt::print("  ipopt       tol = {:g}, acceptable_tol = {:g}, max_iter = {}, print_level = {}",
+  out::print("  ipopt       tol = {:g}, acceptable_tol = {:g}, max_iter = {}, print_level = {}",
              nlp.tol, nlp.acceptable_tol, nlp.max_iter, nlp.print_level);
-  for (const auto& [key, value] : nlp.extra) fmt::print(", {} = {}", key, value);
-  fmt::print("\n");
+  for (const auto& [key, value] : nlp.extra) out::print(", {} = {}", key, value);
+  out::print("\n");
 }
 
 void print_header(const fesd::SimulationProblem& problem) {
@@ -319,11 +361,11 @@ void print_header(const fesd::SimulationProblem& problem) {
   print_model_header(problem.name, problem.source, problem.description, problem.model,
                      problem.has_clock, problem.x0, "", problem.p);
   if (problem.u.size() > 0)
-    fmt::print("  u           {}\n", join_vector(problem.u, problem.model.control_names));
+    out::print("  u           {}\n", join_vector(problem.u, problem.model.control_names));
   print_solver_header(std::to_string(o.discretization.N_FE), o.discretization, o.homotopy, o.nlp);
-  fmt::print("  simulation  T_sim = {:g}, N_sim = {} (step {:g})\n", problem.T_sim, problem.N_sim,
+  out::print("  simulation  T_sim = {:g}, N_sim = {} (step {:g})\n", problem.T_sim, problem.N_sim,
              problem.N_sim > 0 ? problem.T_sim / problem.N_sim : 0.0);
-  std::fflush(stdout);
+  flush_stdout();
 }
 
 /// "[-inf, 2]" per entry, or "none".
@@ -352,26 +394,26 @@ void print_header(const fesd::OcpProblem& problem) {
                      problem.has_clock, ocp.x0, free_x0 ? " (free: the guess)" : "", ocp.p);
   print_solver_header(n_fe, o.discretization, o.homotopy, o.nlp);
   const fesd::OcpFunctions* f = ocp.functions.get();
-  fmt::print("  ocp         T = {:g}, N_stages = {} (control interval {:g}), initialization = {}\n",
+  out::print("  ocp         T = {:g}, N_stages = {} (control interval {:g}), initialization = {}\n",
              ocp.T, ocp.N_stages, ocp.N_stages > 0 ? ocp.T / ocp.N_stages : 0.0,
              o.initialization == fesd::OcpInitialization::Simulation ? "simulation" : "constant");
-  fmt::print("  cost        Lagrange term f_q: {}, Mayer term f_q_T: {}\n",
+  out::print("  cost        Lagrange term f_q: {}, Mayer term f_q_T: {}\n",
              f != nullptr && f->has_f_q() ? "yes" : "no",
              f != nullptr && f->has_f_q_T() ? "yes" : "no");
-  fmt::print("  constraints {} path{}, {} terminal{}", ocp.n_g_path,
+  out::print("  constraints {} path{}, {} terminal{}", ocp.n_g_path,
              o.constraints_at_stages ? " (also at stage points)" : "", ocp.n_g_terminal,
              ocp.terminal_constraint == fesd::TerminalConstraint::L1
                  ? fmt::format(" (relaxed: ell_1, rho_terminal = {:g})", ocp.rho_terminal)
                  : "");
-  fmt::print("\n");
-  if (free_x0) fmt::print("  bounds x0   {}\n", bounds_text(ocp.lbx0, ocp.ubx0));
-  fmt::print("  bounds x    {}\n", bounds_text(ocp.lbx, ocp.ubx));
+  out::print("\n");
+  if (free_x0) out::print("  bounds x0   {}\n", bounds_text(ocp.lbx0, ocp.ubx0));
+  out::print("  bounds x    {}\n", bounds_text(ocp.lbx, ocp.ubx));
   if (ocp.model.n_u() > 0) {
-    fmt::print("  bounds u    {}\n", bounds_text(ocp.lbu, ocp.ubu));
+    out::print("  bounds u    {}\n", bounds_text(ocp.lbu, ocp.ubu));
     if (ocp.u_guess.size() > 0)
-      fmt::print("  u guess     {}\n", join_vector(ocp.u_guess, ocp.model.control_names));
+      out::print("  u guess     {}\n", join_vector(ocp.u_guess, ocp.model.control_names));
   }
-  std::fflush(stdout);
+  flush_stdout();
 }
 
 /// Loads a problem file of either kind, applies the overrides and re-checks the options.
@@ -408,7 +450,7 @@ int run_check(const std::string& file, const Overrides& overrides) {
   } else {
     print_header(load<fesd::SimulationProblem>(file, overrides));
   }
-  fmt::print("check: '{}' is valid (nothing was solved)\n", file);
+  out::print("check: '{}' is valid (nothing was solved)\n", file);
   return kExitSolved;
 }
 
@@ -435,8 +477,8 @@ template <class Result>
 int finish(const Result& result, const std::string& report, const fesd::Pss& model,
            const std::string& title, const SolveArgs& args, const CLI::App& cmd, const char* what) {
   std::fflush(stderr);
-  fmt::print("{}", report);
-  if (!report.empty() && report.back() != '\n') fmt::print("\n");
+  out::print("{}", report);
+  if (!report.empty() && report.back() != '\n') out::print("\n");
 
   const bool solved = result.status == fesd::Status::Success;
   const std::string note =
@@ -446,7 +488,7 @@ int finish(const Result& result, const std::string& report, const fesd::Pss& mod
     if (cmd.count(option) == 0) return;
     try {
       writer();
-      fmt::print("wrote {} {}{}\n", kind, path, note);
+      out::print("wrote {} {}{}\n", kind, path, note);
     } catch (const fesd::IoError& e) {
       io_errors.emplace_back(e.what());
     }
@@ -454,7 +496,7 @@ int finish(const Result& result, const std::string& report, const fesd::Pss& mod
   write("--json", args.json, "JSON", [&] { fesd::write_json(result, model, args.json); });
   write("--csv", args.csv, "CSV ", [&] { fesd::write_csv(result, model, args.csv); });
   write("--plot", args.plot, "plot", [&] { fesd::write_plot(result, model, args.plot, title); });
-  std::fflush(stdout);
+  flush_stdout();
 
   if (!io_errors.empty()) {
     std::string message = io_errors.front();
@@ -493,8 +535,8 @@ Problem prepare(const SolveArgs& args, const CLI::App& cmd) {
   check_outputs(args, cmd);
   if (!args.quiet) {
     print_header(problem);
-    fmt::print("\n");
-    std::fflush(stdout);
+    out::print("\n");
+    flush_stdout();
   }
   if (!args.quiet) show_progress(problem.options);
   return problem;
@@ -532,6 +574,7 @@ int run(int argc, char** argv) {
       "Elements with Switch Detection",
       "fesd"};
   app.set_version_flag("--version", std::string("fesd ") + FESD_VERSION);
+  app.footer(kExitHelp);
   app.require_subcommand(0, 1);
 
   SolveArgs sim;
@@ -585,9 +628,8 @@ int run(int argc, char** argv) {
   return kExitBadInput;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+/// run() with every exception turned into its exit code and one line on stderr.
+int run_and_catch(int argc, char** argv) {
   try {
     return run(argc, argv);
   } catch (const fesd::IoError& e) {
@@ -600,6 +642,9 @@ int main(int argc, char** argv) {
   } catch (const UsageError& e) {
     print_error(e.what());
     return kExitBadInput;
+  } catch (const fesd::InternalError& e) {  // "internal: ..."
+    print_error(std::string("internal error: ") + e.what());
+    return kExitInternal;
   } catch (const std::bad_alloc&) {
     print_error("internal error: out of memory");
     return kExitInternal;
@@ -610,4 +655,20 @@ int main(int argc, char** argv) {
     print_error("internal error: unknown exception");
     return kExitInternal;
   }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // `fesd simulate ... | head -1`: a reader that goes away makes writes fail (EPIPE) instead of
+  // killing the program, so the run finishes and writes its --json/--csv/--plot files.
+  std::signal(SIGPIPE, SIG_IGN);
+  const int code = run_and_catch(argc, argv);
+  if (!stdout_ok() && code != kExitBadInput && code != kExitInternal) {
+    // Also `fesd check FILE > /dev/full`: what was printed is lost, so nothing succeeded.
+    std::cerr << "fesd: error: cannot write to standard output: " << std::strerror(stdout_errno)
+              << std::endl;
+    return kExitIo;
+  }
+  return code;
 }

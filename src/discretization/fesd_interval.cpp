@@ -6,6 +6,9 @@
 #include <map>
 #include <unordered_map>
 
+#include <fmt/format.h>
+
+#include "fesd/ad.hpp"
 #include "fesd/error.hpp"
 #include "nlp/sum_block.hpp"
 
@@ -176,6 +179,52 @@ FesdInterval::FesdInterval(const Pss& model, const Tableau& tableau,
                             (options.rk_scheme == RkScheme::LobattoIIIC || tab_.is_explicit)));
 }
 
+std::vector<std::string> FesdInterval::block_size_errors(const Pss& m,
+                                                         const DiscretizationOptions& options) {
+  std::vector<std::string> errors;
+  const int limit = ad::kMaxInputs;
+  const int n_x = m.n_x(), n_th = m.n_theta();
+  // The model's blocks, as build() creates them (the same functors, so the counts cannot drift).
+  const int dynamics = DynamicsEq{&m}.num_inputs();  // 2 n_x + n_theta + n_u + n_p
+  const int lp = LpEq{&m, {}}.num_inputs();          // n_x + n_theta + n_sys + n_p
+  if (std::max(dynamics, lp) > limit) {
+    const bool states = 2 * n_x >= n_th;  // name what dominates
+    const std::string key =
+        states
+            ? fmt::format("model.x = {} states", n_x)
+            : fmt::format("{} = {} regions", m.n_sys() > 1 ? "model.subsystem" : "model.F", n_th);
+    const std::string block =
+        dynamics >= lp
+            ? fmt::format(
+                  "the dynamics (25) of one stage are one block of 2 n_x + n_theta + n_u "
+                  "+ n_p = {} inputs",
+                  dynamics)
+            : fmt::format(
+                  "the LP (9) of one stage is one block of n_x + n_theta + n_sys + n_p = "
+                  "{} inputs",
+                  lp);
+    errors.push_back(fmt::format(
+        "{}: {} (n_x = {}, n_theta = {}, n_u = {}, n_p = {}); at most {} inputs per block are "
+        "supported ({})",
+        key, block, n_x, n_th, m.n_u(), m.n_p(), limit,
+        states ? "use fewer states"
+               : "give S with only the regions that can occur, or fewer switching functions"));
+  }
+  const StepEq se = options.step_eq;
+  if (options.use_fesd && options.N_FE >= 2 &&
+      (se == StepEq::Eta || se == StepEq::EtaTanh || se == StepEq::L2Relaxed)) {
+    const int step_eq = 2 + 4 * n_th;  // h_{n-1}, h_n and 4 lifted sums per region
+    if (step_eq > limit)
+      errors.push_back(fmt::format(
+          "discretization.step_equilibration = {}: the step equilibration (31) of two neighbouring "
+          "elements is one block of 2 + 4 n_theta = {} inputs with n_theta = {} regions; at most "
+          "{} inputs per block are supported, i.e. n_theta <= {} (use heuristic_mean or none, or "
+          "fewer regions)",
+          to_string(se), step_eq, n_th, limit, (limit - 2) / 4));
+  }
+  return errors;
+}
+
 void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
   in_ = in;
   const Pss& m = model_;
@@ -184,7 +233,7 @@ void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
       static_cast<int>(in.p.size()) != m.n_p() ||
       static_cast<int>(in.lambda_start.size()) != n_th ||
       static_cast<int>(in.mu_start.size()) != n_sys)
-    throw Error("internal: FesdInterval inputs do not match the model dimensions");
+    throw InternalError("internal: FesdInterval inputs do not match the model dimensions");
   const bool fesd = opt_.use_fesd;
   const double h0 = in.T / N_FE_;
 

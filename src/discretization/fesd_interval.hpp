@@ -14,6 +14,7 @@
 // Integrator and OCP both build their NLPs from this block; its layout (which variable is
 // theta_{n,m,r}, h_n, ...) stays reachable for active-set and sensitivity code.
 #pragma once
+#include <string>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -62,6 +63,14 @@ class FesdInterval {
 
   /// Adds variables and constraint/objective blocks to `nlp`.
   void build(nlp::BlockNlp& nlp, const IntervalInputs& in);
+
+  /// The input check of build(): one message per block of the interval whose number of inputs
+  /// would exceed ad::kMaxInputs (derivatives by forward AD). Sums and complementarity rows have
+  /// no limit; the dynamics (25) and LP (9) blocks grow with n_x and the number of regions, the
+  /// step equilibration (31) block with the number of regions. Each message starts with the
+  /// problem-file key to change ("model.F = 1024 regions: ..."). Empty: build() will not fail.
+  static std::vector<std::string> block_size_errors(const Pss& model,
+                                                    const DiscretizationOptions& options);
 
   /// Sets the initial guess w of every variable of the interval: states on the explicit Euler
   /// prediction from x0 with derivative xdot, algebraic variables from the LP solution.

@@ -15,6 +15,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "core/limits.hpp"
 #include "dcs/stewart.hpp"
 #include "discretization/fesd_interval.hpp"
 #include "fesd/error.hpp"
@@ -129,6 +130,11 @@ void check_input(const Pss& model, const Eigen::VectorXd& x0, double T_sim, int 
   if (!std::isfinite(T_sim) || T_sim <= 0)
     throw InvalidOption(fmt::format("T_sim = {}: must be finite and > 0", T_sim));
   if (N_sim < 1) throw InvalidOption(fmt::format("N_sim = {}: must be >= 1", N_sim));
+  if (std::string e = core::step_length_error("T_sim", T_sim, "N_sim", N_sim); !e.empty())
+    throw InvalidOption(e);
+  if (auto e = discretization::FesdInterval::block_size_errors(model, options.discretization);
+      !e.empty())
+    throw InvalidModel(fmt::format("{}", fmt::join(e, "; ")));
   if (u.size() != model.n_u())
     throw InvalidModel(fmt::format("u has {} entries, expected n_u = {}", u.size(), model.n_u()));
   if (p.size() != model.n_p())

@@ -29,16 +29,16 @@ ExpressionOcpFunctions::ExpressionOcpFunctions(ExpressionLayout layout, OcpExpre
   const auto check = [&](const expr::Expression& e, const char* what, bool controls_allowed) {
     const std::vector<int>& deps = e.dependencies();
     if (!deps.empty() && deps.back() >= n_symbols)
-      throw InvalidModel(
-          fmt::format("ocp expressions: {} = '{}' reads input {}, but there are "
+      throw InternalError(
+          fmt::format("internal: ocp expressions: {} = '{}' reads input {}, but there are "
                       "only {} symbols",
-                      what, e.text(), deps.back(), n_symbols));
+                      what, expr::shorten(e.text()), deps.back(), n_symbols));
     if (!controls_allowed)
       for (int i = first_u; i < first_u + layout_.n_u; ++i)
         if (e.depends_on(i))
-          throw InvalidModel(
-              fmt::format("ocp expressions: {} = '{}' reads a control; it depends on x and p only",
-                          what, e.text()));
+          throw InternalError(fmt::format(
+              "internal: ocp expressions: {} = '{}' reads a control; it depends on x and p only",
+              what, expr::shorten(e.text())));
   };
   if (e_.f_q) check(*e_.f_q, "f_q", true);
   if (e_.f_q_T) check(*e_.f_q_T, "f_q_T", false);

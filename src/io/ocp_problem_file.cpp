@@ -26,6 +26,7 @@
 #include "fesd/problem_file.hpp"
 #include "io/ocp_expression_functions.hpp"
 #include "io/problem_file_reader.hpp"
+#include "ocp/ocp_checks.hpp"
 
 namespace fesd {
 namespace {
@@ -87,6 +88,7 @@ std::vector<std::string> validate_ocp(const OcpProblem& q) {
   const Ocp& o = q.ocp;
   if (!(std::isfinite(o.T) && o.T > 0)) e.push_back(fmt::format("ocp.T = {}: must be > 0", o.T));
   if (o.N_stages < 1) e.push_back(fmt::format("ocp.N_stages = {}: must be >= 1", o.N_stages));
+  if (std::string s = ocp_detail::step_length_error(o); !s.empty()) e.push_back(std::move(s));
   if (!o.N_FE.empty()) {
     if (static_cast<int>(o.N_FE.size()) != o.N_stages)
       e.push_back(fmt::format(
@@ -118,6 +120,9 @@ std::vector<std::string> validate_ocp(const OcpProblem& q) {
 std::vector<std::string> validate_all(const OcpProblem& q) {
   std::vector<std::string> e = validate_ocp(q);
   for (std::string& s : validate(q.options)) e.push_back(std::move(s));
+  if (e.empty())  // the limits of the NLP's blocks, docs/problem-files.md "Limits"
+    for (std::string& s : ocp_detail::block_size_errors(q.ocp, q.options))
+      e.push_back(std::move(s));
   return e;
 }
 

@@ -19,6 +19,8 @@
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
+#include "core/limits.hpp"
+#include "discretization/fesd_interval.hpp"
 #include "fesd/error.hpp"
 #include "fesd/problem_file.hpp"
 #include "io/problem_file_reader.hpp"
@@ -53,6 +55,15 @@ std::vector<std::string> validate_simulation(const SimulationProblem& q) {
   if (!(std::isfinite(q.T_sim) && q.T_sim > 0))
     e.push_back(fmt::format("simulation.T_sim = {}: must be > 0", q.T_sim));
   if (q.N_sim < 1) e.push_back(fmt::format("simulation.N_sim = {}: must be >= 1", q.N_sim));
+  const double t0 = q.has_clock ? q.x0[q.x0.size() - 1] : 0.0;  // the clock starts at t0
+  if (std::string s =
+          core::step_length_error("simulation.T_sim", q.T_sim, "simulation.N_sim", q.N_sim, t0);
+      !s.empty())
+    e.push_back(std::move(s));
+  if (validate(q.options).empty())  // the limits of build(), docs/problem-files.md "Limits"
+    for (std::string& s :
+         discretization::FesdInterval::block_size_errors(q.model, q.options.discretization))
+      e.push_back(std::move(s));
   return e;
 }
 

@@ -379,7 +379,7 @@ void check_no_controls(const Reader& r, const expr::Expression& e, const toml::n
       r.fail(n.source(), path,
              fmt::format("{} cannot depend on controls (expected a function of x and p, got "
                          "control '{}' in \"{}\")",
-                         what, sym.u[j], e.text()));
+                         what, sym.u[j], expr::shorten(e.text())));
 }
 
 bool ModelSpec::uses_time() const {

@@ -98,14 +98,16 @@ const Function* find_function(std::string_view name) {
 /// x^m, m >= 1, by square-and-multiply.
 template <class T>
 T positive_power(const T& x, int m) {
-  if (m == 1) return x;
+  if (m <= 1) return x;  // m >= 1 is the caller's promise; never recurse below 1
   if (m == 2) return x * x;
   if (m == 3) return x * x * x;
   const T h = positive_power(x, m / 2);
   return m % 2 != 0 ? h * h * x : h * h;
 }
+/// x^n for an integer n: x^0 = 1 for every x (as std::pow, also 0^0), x^-n = 1 / x^n.
 template <class T>
 T integer_power(const T& x, int n) {
+  if (n == 0) return T(1.0);
   return n > 0 ? positive_power(x, n) : 1.0 / positive_power(x, -n);
 }
 
@@ -317,6 +319,9 @@ std::string_view closest(std::string_view name, const std::vector<std::string_vi
   std::string_view best;
   std::size_t best_distance = 3;
   for (std::string_view c : candidates) {
+    // The distance is at least the difference of the lengths: skip (a long name is cheap).
+    if (std::max(name.size(), c.size()) - std::min(name.size(), c.size()) >= best_distance)
+      continue;
     const std::size_t dist = edit_distance(name, c);
     if (dist < best_distance && dist < std::max(name.size(), c.size())) {
       best = c;
@@ -324,6 +329,21 @@ std::string_view closest(std::string_view name, const std::vector<std::string_vi
     }
   }
   return best;
+}
+
+/// Longest part of an expression (in characters) quoted in a message; longer ones end in "...".
+constexpr std::size_t kShownChars = 60;
+
+/// `s` as a message quotes it: on one line (control characters as spaces), at most kShownChars
+/// UTF-8 characters, then "..." if there is more (a 2 MB expression must not make a 2 MB message).
+std::string shown(std::string_view s) {
+  std::string out;
+  std::size_t chars = 0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (!is_continuation(s[i]) && chars++ == kShownChars) return out + "...";
+    out += static_cast<unsigned char>(s[i]) < 0x20 ? ' ' : s[i];
+  }
+  return out;
 }
 
 std::string describe(double v) {
@@ -387,14 +407,14 @@ class Parser {
   [[noreturn]] void syntax(const std::string& what) const {
     fail("cannot parse " + quoted() + ": " + what);
   }
-  /// The text in quotes, on one line.
-  std::string quoted() const {
-    std::string q = "'";
-    for (char c : text_) q += static_cast<unsigned char>(c) < 0x20 ? ' ' : c;
-    return q + "'";
-  }
+  /// The text in quotes, on one line, shortened (shown()).
+  std::string quoted() const { return "'" + shown(text_) + "'"; }
   std::string span(std::size_t begin, std::size_t end) const {
     return std::string(text_.substr(begin, end - begin));
+  }
+  /// A part of the text as a message shows it (shown()).
+  std::string shown_span(std::size_t begin, std::size_t end) const {
+    return shown(text_.substr(begin, end - begin));
   }
   /// 1-based column of a byte offset, counting UTF-8 characters.
   std::string column(std::size_t offset) const {
@@ -405,7 +425,7 @@ class Parser {
   }
   std::string unexpected() const {
     const Token& t = tok();
-    return "unexpected '" + span(t.begin, t.end) + "' at column " + column(t.begin);
+    return "unexpected '" + shown_span(t.begin, t.end) + "' at column " + column(t.begin);
   }
   [[noreturn]] void expected_operand() const {
     const Token& t = tok();
@@ -420,7 +440,7 @@ class Parser {
   }
   void check_folded(double v, std::size_t begin, std::size_t end) const {
     if (!std::isfinite(v))
-      fail("constant subexpression '" + span(begin, end) + "' evaluates to " + describe(v) +
+      fail("constant subexpression '" + shown_span(begin, end) + "' evaluates to " + describe(v) +
            " in " + quoted());
   }
 
@@ -444,7 +464,7 @@ class Parser {
       } else {
         std::size_t e = p + 1;
         while (e < n && is_continuation(text_[e])) ++e;
-        syntax("unexpected character '" + span(p, e) + "' at column " + column(p));
+        syntax("unexpected character '" + shown_span(p, e) + "' at column " + column(p));
       }
     }
     tokens_.push_back({Token::kEnd, n, n});
@@ -460,7 +480,7 @@ class Parser {
       std::size_t q = p + 1;
       if (q < n && (text_[q] == '+' || text_[q] == '-')) ++q;
       if (q >= n || !is_digit(text_[q]))
-        syntax("malformed number '" + span(b, q) + "' at column " + column(b) +
+        syntax("malformed number '" + shown_span(b, q) + "' at column " + column(b) +
                ": the exponent has no digits");
       p = q;
       while (p < n && is_digit(text_[p])) ++p;
@@ -469,10 +489,10 @@ class Parser {
     const auto [ptr, ec] = std::from_chars(text_.data() + b, text_.data() + p, v);
     if (ec == std::errc::result_out_of_range) {
       if (overflows(b, p))
-        fail("number '" + span(b, p) + "' is too large (not a finite double) in " + quoted());
+        fail("number '" + shown_span(b, p) + "' is too large (not a finite double) in " + quoted());
       v = 0.0;  // underflow
     } else if (ec != std::errc() || ptr != text_.data() + p) {
-      syntax("malformed number '" + span(b, p) + "' at column " + column(b));
+      syntax("malformed number '" + shown_span(b, p) + "' at column " + column(b));
     }
     tokens_.push_back({Token::kNumber, b, p, v});
     return p;
@@ -614,9 +634,10 @@ class Parser {
     if (find_function(name))
       fail("'" + name + "' is a function, not a symbol, in " + quoted() + " (write '" + name +
            "(...)')");
+    const std::string name_shown = shown(name);
     std::vector<std::string_view> candidates(symbols_.begin(), symbols_.end());
     candidates.push_back("pi");
-    std::string message = "unknown symbol '" + name + "' in " + quoted() + " (";
+    std::string message = "unknown symbol '" + name_shown + "' in " + quoted() + " (";
     if (const std::string_view s = closest(name, candidates); !s.empty())
       message += "did you mean '" + std::string(s) + "'?; ";
     message += "known symbols: ";
@@ -628,6 +649,7 @@ class Parser {
   Operand call(const Token& name_token) {
     const std::string name = span(name_token.begin, name_token.end);
     const Function* f = find_function(name);
+    const std::string name_shown = shown(name);
     if (!f) {
       if (find_symbol(name) >= 0)
         fail("'" + name + "' is a symbol, not a function, in " + quoted() + " (write '" + name +
@@ -639,7 +661,7 @@ class Parser {
         names.push_back(g.name);
         list += (list.empty() ? "" : ", ") + std::string(g.name);
       }
-      std::string message = "unknown function '" + name + "'";
+      std::string message = "unknown function '" + name_shown + "'";
       if (const std::string_view s = closest(name, names); !s.empty())
         message += " (did you mean '" + std::string(s) + "'?)";
       fail(message + " in " + quoted() + "; functions are " + list);
@@ -763,6 +785,10 @@ class Parser {
 };
 
 }  // namespace
+
+std::string shorten(std::string_view text) {
+  return shown(text);
+}
 
 // ---- Expression ---------------------------------------------------------------------------------
 struct Expression::Program {

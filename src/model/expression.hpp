@@ -63,4 +63,7 @@ class Expression {
   std::shared_ptr<const Program> program_;
 };
 
+/// `text` as error messages quote an expression: on one line, at most 60 characters, then "...".
+std::string shorten(std::string_view text);
+
 }  // namespace fesd::expr

@@ -68,14 +68,16 @@ ExpressionModel::ExpressionModel(ExpressionLayout layout,
                                  std::vector<ExpressionSubsystem> subsystems)
     : layout_(layout) {
   const ExpressionLayout& L = layout_;
-  if (L.n_x < 1) throw InvalidModel(fmt::format("expression model: n_x = {}: must be >= 1", L.n_x));
+  if (L.n_x < 1)
+    throw InternalError(fmt::format("internal: expression model: n_x = {}: must be >= 1", L.n_x));
   if (L.n_x_slots != L.n_x && L.n_x_slots != L.n_x + 1)
-    throw InvalidModel(fmt::format("expression model: n_x_slots = {}: must be n_x = {} or n_x + 1",
-                                   L.n_x_slots, L.n_x));
+    throw InternalError(
+        fmt::format("internal: expression model: n_x_slots = {}: must be n_x = {} or n_x + 1",
+                    L.n_x_slots, L.n_x));
   if (L.n_u < 0 || L.n_p < 0)
-    throw InvalidModel(
-        fmt::format("expression model: n_u = {}, n_p = {}: must be >= 0", L.n_u, L.n_p));
-  if (subsystems.empty()) throw InvalidModel("expression model: no subsystem given");
+    throw InternalError(
+        fmt::format("internal: expression model: n_u = {}, n_p = {}: must be >= 0", L.n_u, L.n_p));
+  if (subsystems.empty()) throw InternalError("internal: expression model: no subsystem given");
 
   const int first_u = L.n_x_slots;
   const auto reads_control = [&](const expr::Expression& e) {
@@ -85,32 +87,32 @@ ExpressionModel::ExpressionModel(ExpressionLayout layout,
   };
   const auto check_symbols = [&](const expr::Expression& e, const std::string& what) {
     if (max_dependency(e) >= L.n_symbols())
-      throw InvalidModel(
-          fmt::format("expression model: {} = '{}' reads input {}, but there are "
+      throw InternalError(
+          fmt::format("internal: expression model: {} = '{}' reads input {}, but there are "
                       "only {} symbols",
-                      what, e.text(), max_dependency(e), L.n_symbols()));
+                      what, expr::shorten(e.text()), max_dependency(e), L.n_symbols()));
   };
 
   for (std::size_t k = 0; k < subsystems.size(); ++k) {
     ExpressionSubsystem& s = subsystems[k];
-    const std::string where = fmt::format("expression model: subsystem {}", k);
+    const std::string where = fmt::format("internal: expression model: subsystem {}", k);
     if (s.c.empty() == s.g.empty())
-      throw InvalidModel(where + ": give either switching functions c or indicator functions g");
-    if (s.F.empty()) throw InvalidModel(where + ": no vector fields F");
+      throw InternalError(where + ": give either switching functions c or indicator functions g");
+    if (s.F.empty()) throw InternalError(where + ": no vector fields F");
     for (const auto& list : {std::cref(s.c), std::cref(s.g)}) {
       for (const expr::Expression& e : list.get()) {
         check_symbols(e, where + " c/g");
         if (reads_control(e))
-          throw InvalidModel(
+          throw InternalError(
               fmt::format("{}: '{}' reads a control; switching and indicator "
                           "functions depend on x and p only",
-                          where, e.text()));
+                          where, expr::shorten(e.text())));
       }
     }
     for (std::size_t i = 0; i < s.F.size(); ++i) {
       if (static_cast<int>(s.F[i].size()) != L.n_x)
-        throw InvalidModel(fmt::format("{}: F[{}] has {} components, expected n_x = {}", where, i,
-                                       s.F[i].size(), L.n_x));
+        throw InternalError(fmt::format("{}: F[{}] has {} components, expected n_x = {}", where, i,
+                                        s.F[i].size(), L.n_x));
       for (const expr::Expression& e : s.F[i]) check_symbols(e, fmt::format("{} F[{}]", where, i));
     }
     for (expr::Expression& e : s.c) c_.push_back(std::move(e));
@@ -150,24 +152,25 @@ FESD_FOR_EACH_SCALAR(FESD_DEFINE_EXPRESSION_FUNCTIONS)
 Pss make_expression_pss(PssDims dims, ExpressionLayout layout,
                         std::vector<ExpressionSubsystem> subsystems) {
   if (dims.n_x != layout.n_x || dims.n_u != layout.n_u || dims.n_p != layout.n_p)
-    throw InvalidModel(
-        fmt::format("expression model: dims (n_x {}, n_u {}, n_p {}) differ from "
+    throw InternalError(
+        fmt::format("internal: expression model: dims (n_x {}, n_u {}, n_p {}) differ from "
                     "the expression layout (n_x {}, n_u {}, n_p {})",
                     dims.n_x, dims.n_u, dims.n_p, layout.n_x, layout.n_u, layout.n_p));
   if (dims.subsystems.size() != subsystems.size())
-    throw InvalidModel(fmt::format("expression model: {} subsystems in dims, {} with expressions",
-                                   dims.subsystems.size(), subsystems.size()));
+    throw InternalError(
+        fmt::format("internal: expression model: {} subsystems in dims, {} with expressions",
+                    dims.subsystems.size(), subsystems.size()));
   for (std::size_t k = 0; k < subsystems.size(); ++k) {
     const Subsystem& d = dims.subsystems[k];
     const ExpressionSubsystem& s = subsystems[k];
     if (d.n_c != static_cast<int>(s.c.size()) || d.n_g != static_cast<int>(s.g.size()))
-      throw InvalidModel(
-          fmt::format("expression model: subsystem {}: n_c = {}, n_g = {} but {} c "
+      throw InternalError(
+          fmt::format("internal: expression model: subsystem {}: n_c = {}, n_g = {} but {} c "
                       "and {} g expressions",
                       k, d.n_c, d.n_g, s.c.size(), s.g.size()));
     if (d.n_f() != static_cast<int>(s.F.size()))
-      throw InvalidModel(
-          fmt::format("expression model: subsystem {}: {} regions but {} vector "
+      throw InternalError(
+          fmt::format("internal: expression model: subsystem {}: {} regions but {} vector "
                       "fields F",
                       k, d.n_f(), s.F.size()));
   }

@@ -8,35 +8,10 @@
 
 #include "fesd/error.hpp"
 #include "nlp/block.hpp"
+#include "nlp/sum_block.hpp"
 
 namespace fesd::mpcc {
 namespace {
-
-/// sum_p w[a_p] * w[b_p] over local indices.
-struct ProductSum {
-  std::vector<std::pair<int, int>> pairs;
-  int k = 0;
-  int num_inputs() const { return k; }
-  int num_outputs() const { return 1; }
-  template <class T>
-  void operator()(const T* w, T* c) const {
-    T s(0.0);
-    for (const auto& [a, b] : pairs) s = s + w[a] * w[b];
-    c[0] = s;
-  }
-};
-
-/// Elastic row: sum of products - s (s is the last input).
-struct ElasticRow {
-  ProductSum sum;
-  int num_inputs() const { return sum.k + 1; }
-  int num_outputs() const { return 1; }
-  template <class T>
-  void operator()(const T* w, T* c) const {
-    sum(w, c);
-    c[0] = c[0] - w[sum.k];
-  }
-};
 
 /// Smoothed Fischer-Burmeister function of one complementarity pair (a, B):
 /// phi = a + B - sqrt(a^2 + B^2 + 2 sigma), with a = w[0] the factor all products of the group
@@ -70,7 +45,7 @@ struct Identity {
 /// A group's products over local indices into its distinct variables (in order of appearance).
 struct LocalGroup {
   std::vector<int> vars;
-  ProductSum sum;
+  nlp::ProductSum sum;  // hand-written derivatives: no input limit (nlp/sum_block.hpp)
 };
 
 LocalGroup localize(const CompGroup& g) {
@@ -171,8 +146,7 @@ Relaxation::Relaxation(nlp::BlockNlp& nlp, const std::vector<CompGroup>& groups,
         group_rows_[k] = add_fischer_burmeister_row(nlp, g, sigma_var_);
         break;
       case MpccMode::L1Penalty: {
-        // One objective term per group, not one for all: a block has at most ad::kMaxInputs
-        // inputs.
+        // One objective term per group.
         LocalGroup lg = localize(g);
         objectives_.push_back(
             nlp.add_objective(nlp::make_block(std::move(lg.sum)), std::move(lg.vars), 1.0));
@@ -181,8 +155,9 @@ Relaxation::Relaxation(nlp::BlockNlp& nlp, const std::vector<CompGroup>& groups,
       case MpccMode::ElasticIneq: {
         LocalGroup lg = localize(g);
         lg.vars.push_back(elastic_var_);
-        group_rows_[k] = nlp.add_constraint(nlp::make_block(ElasticRow{std::move(lg.sum)}),
-                                            std::move(lg.vars), -nlp::kInf, 0.0);
+        lg.sum.minus_last = true;  // sum of products - s <= 0
+        group_rows_[k] = nlp.add_constraint(nlp::make_block(std::move(lg.sum)), std::move(lg.vars),
+                                            -nlp::kInf, 0.0);
         break;
       }
       case MpccMode::ScholtesIneq:

@@ -43,9 +43,10 @@ decltype(auto) with_capacity(int k, Fn&& fn) {
   if (k <= ad::kCapacities[0]) return fn.template operator()<ad::kCapacities[0]>();
   if (k <= ad::kCapacities[1]) return fn.template operator()<ad::kCapacities[1]>();
   if (k <= ad::kCapacities[2]) return fn.template operator()<ad::kCapacities[2]>();
-  throw InvalidModel("a derivative block has " + std::to_string(k) + " inputs; at most " +
-                     std::to_string(ad::kMaxInputs) +
-                     " are supported (reduce n_x, n_s or the number of regions)");
+  // Inputs above the limit are rejected before building (FesdInterval::block_size_errors).
+  throw InternalError("internal: a derivative block has " + std::to_string(k) +
+                      " inputs; at most " + std::to_string(ad::kMaxInputs) +
+                      " are supported and the input checks should have said so");
 }
 
 template <class T>

@@ -21,7 +21,7 @@ int BlockNlp::add_constraint(std::shared_ptr<const Block> block, std::vector<int
   const int m = block->num_outputs();
   if (static_cast<int>(vars.size()) != block->num_inputs() || static_cast<int>(lb.size()) != m ||
       static_cast<int>(ub.size()) != m)
-    throw Error("internal: constraint block sizes do not match its variables or bounds");
+    throw InternalError("internal: constraint block sizes do not match its variables or bounds");
   g_lb.insert(g_lb.end(), lb.begin(), lb.end());
   g_ub.insert(g_ub.end(), ub.begin(), ub.end());
   constraints_.push_back({std::move(block), std::move(vars), first, 1.0, nullptr, {}, {}});
@@ -39,7 +39,7 @@ int BlockNlp::add_constraint(std::shared_ptr<const Block> block, std::vector<int
 int BlockNlp::add_objective(std::shared_ptr<const Block> block, std::vector<int> vars,
                             double weight) {
   if (block->num_outputs() != 1 || static_cast<int>(vars.size()) != block->num_inputs())
-    throw Error("internal: objective block must have one output and match its variables");
+    throw InternalError("internal: objective block must have one output and match its variables");
   objectives_.push_back({std::move(block), std::move(vars), -1, weight, nullptr, {}, {}});
   finalized_ = false;
   return static_cast<int>(objectives_.size()) - 1;

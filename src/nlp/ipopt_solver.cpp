@@ -195,6 +195,11 @@ bool load_dense_kkt() {
 }
 
 void set_option(Ipopt::IpoptApplication& app, const std::string& name, const std::string& value) {
+  if (name == "option_file_name")
+    throw InvalidOption(fmt::format(
+        "ipopt.option_file_name = '{}': fesd reads no IPOPT options file (give the options in "
+        "[ipopt] or with --ipopt NAME=VALUE)",
+        value));
   Ipopt::SmartPtr<const Ipopt::RegisteredOption> opt = app.RegOptions()->GetOption(name);
   if (!Ipopt::IsValid(opt)) throw InvalidOption(fmt::format("ipopt.{}: not an IPOPT option", name));
   bool ok = false;
@@ -248,7 +253,10 @@ IpoptSolver::IpoptSolver(const NlpOptions& o) : impl_(std::make_unique<Impl>()) 
   }
   app.Options()->GetNumericValue("tol", impl_->tol, "");
   app.Options()->GetIntegerValue("max_iter", impl_->max_iter, "");
-  if (app.Initialize() != Ipopt::Solve_Succeeded)
+  // Initialize() without a file name would read the option_file_name option's file, by default
+  // "ipopt.opt" in the working directory, and let it change every solve. "" reads no file; the
+  // options are only those above (no output file unless [ipopt] output_file asks for one).
+  if (app.Initialize("") != Ipopt::Solve_Succeeded)
     throw InvalidOption("ipopt: initialization failed (check the [ipopt] options)");
 }
 

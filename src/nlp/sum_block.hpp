@@ -1,6 +1,21 @@
-// src/nlp/sum_block.hpp: the linear block c = sum_i w_i (optionally minus a lifted variable w_0),
-// shared by the discretization (sum h_n = T, lifted sums of (31)) and the OCP (l1 slack penalty).
+// src/nlp/sum_block.hpp: the blocks whose number of inputs grows with the problem (N_FE, the
+// complementarity pairs of a group), written with their exact derivatives by hand, so that they
+// have no input limit (AutoDiffBlock has at most ad::kMaxInputs):
+//   Sum         c = sum_i w_i, or sum_{i >= 1} w_i - w_0 (sum h_n = T, the lifted sums of (31), the
+//               OCP's l1 slack penalty)
+//   ProductSum  c = sum_p w_{a_p} w_{b_p}, optionally - w_k (complementarity rows of a group, the
+//               elastic mode's row)
+// `make_block(Sum{...})` and `make_block(ProductSum{...})` give these hand-written blocks; the
+// functors keep a templated operator() so that tests can compare them with AutoDiffBlock. Values
+// and derivatives are summed in the same order as the AD versions, so results are bit-identical.
 #pragma once
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <utility>
+#include <vector>
+
+#include "nlp/block.hpp"
 
 namespace fesd::nlp {
 
@@ -18,5 +33,136 @@ struct Sum {
     c[0] = minus_first ? s - w[0] : s;
   }
 };
+
+/// c[0] = sum_p w[a_p] * w[b_p] over local indices (pairs), with `minus_last` minus the extra
+/// input w[k] (the elastic variable s: sum - s). Inputs: k (+ 1 with minus_last).
+struct ProductSum {
+  std::vector<std::pair<int, int>> pairs;
+  int k = 0;  ///< inputs read by the pairs (local indices 0..k-1)
+  bool minus_last = false;
+  int num_inputs() const { return minus_last ? k + 1 : k; }
+  int num_outputs() const { return 1; }
+  template <class T>
+  void operator()(const T* w, T* c) const {
+    T s(0.0);
+    for (const auto& [a, b] : pairs) s = s + w[a] * w[b];
+    c[0] = minus_last ? s - w[k] : s;
+  }
+};
+
+/// Sum as a Block: the Jacobian is constant (+-1), the Hessian zero.
+class SumBlock final : public Block {
+ public:
+  explicit SumBlock(Sum f) : f_(f) {}
+  int num_inputs() const override { return f_.k; }
+  int num_outputs() const override { return 1; }
+  bool eval(const double* w, double* c) const override {
+    f_(w, c);
+    return std::isfinite(c[0]);
+  }
+  bool jacobian(const double* w, double* c, double* J) const override {
+    f_(w, c);
+    for (int i = 0; i < f_.k; ++i) J[i] = 1.0;
+    if (f_.minus_first && f_.k > 0) J[0] = -1.0;
+    return std::isfinite(c[0]);
+  }
+  bool hessian(const double*, const double*, const std::vector<int>& cols,
+               double* H) const override {
+    for (int j : cols) std::fill_n(H + static_cast<std::size_t>(j) * f_.k, f_.k, 0.0);
+    return true;
+  }
+  BlockPattern pattern(const double*) const override {
+    BlockPattern bp;
+    bp.jac_rows.assign(1, {});
+    for (int i = 0; i < f_.k; ++i) bp.jac_rows[0].push_back(i);
+    return bp;
+  }
+
+ private:
+  Sum f_;
+};
+
+/// ProductSum as a Block: dc/dw_a = sum of the partners of a, the Hessian a constant 0/1 matrix.
+class ProductSumBlock final : public Block {
+ public:
+  explicit ProductSumBlock(ProductSum f) : f_(std::move(f)) {
+    for (const auto& [a, b] : f_.pairs)
+      hess_.emplace_back(std::max(a, b), std::min(a, b));  // (i >= j), as ad::Pattern
+    std::sort(hess_.begin(), hess_.end());
+    hess_.erase(std::unique(hess_.begin(), hess_.end()), hess_.end());
+  }
+  int num_inputs() const override { return f_.num_inputs(); }
+  int num_outputs() const override { return 1; }
+  bool eval(const double* w, double* c) const override {
+    f_(w, c);
+    return std::isfinite(c[0]);
+  }
+  bool jacobian(const double* w, double* c, double* J) const override {
+    const int k = num_inputs();
+    f_(w, c);
+    std::fill_n(J, k, 0.0);
+    for (const auto& [a, b] : f_.pairs) {  // d(w_a w_b) = w_b dw_a + w_a dw_b
+      if (a == b) {
+        J[a] += 2.0 * w[a];
+      } else {
+        J[a] += w[b];
+        J[b] += w[a];
+      }
+    }
+    if (f_.minus_last) J[f_.k] = -1.0;
+    bool ok = std::isfinite(c[0]);
+    for (int i = 0; i < k; ++i) ok = ok && std::isfinite(J[i]);
+    return ok;
+  }
+  bool hessian(const double*, const double* y, const std::vector<int>& cols,
+               double* H) const override {
+    const int k = num_inputs();
+    std::vector<char>& wanted = scratch<char>(static_cast<std::size_t>(k), 0);
+    std::fill_n(wanted.begin(), k, 0);
+    for (int j : cols) {
+      std::fill_n(H + static_cast<std::size_t>(j) * k, k, 0.0);
+      wanted[j] = 1;
+    }
+    // d^2(w_a w_b) = e_a e_b' + e_b e_a': count the entries, then scale by y (as AD does).
+    for (const auto& [a, b] : f_.pairs) {
+      if (wanted[b]) H[static_cast<std::size_t>(b) * k + a] += 1.0;
+      if (wanted[a]) H[static_cast<std::size_t>(a) * k + b] += 1.0;
+    }
+    for (int j : cols) {
+      double* col = H + static_cast<std::size_t>(j) * k;
+      for (int i = 0; i < k; ++i) col[i] *= y[0];
+    }
+    return std::isfinite(y[0]);
+  }
+  BlockPattern pattern(const double*) const override {
+    BlockPattern bp;
+    std::vector<int> row;
+    for (const auto& [a, b] : f_.pairs) {
+      row.push_back(a);
+      row.push_back(b);
+    }
+    if (f_.minus_last) row.push_back(f_.k);
+    std::sort(row.begin(), row.end());
+    row.erase(std::unique(row.begin(), row.end()), row.end());
+    bp.jac_rows.assign(1, std::move(row));
+    bp.hess = hess_;
+    for (const auto& [i, j] : bp.hess) bp.hess_cols.push_back(j);
+    std::sort(bp.hess_cols.begin(), bp.hess_cols.end());
+    bp.hess_cols.erase(std::unique(bp.hess_cols.begin(), bp.hess_cols.end()), bp.hess_cols.end());
+    return bp;
+  }
+
+ private:
+  ProductSum f_;
+  std::vector<std::pair<int, int>> hess_;
+};
+
+/// The hand-written blocks for Sum and ProductSum (exact match: preferred over the AD template).
+inline std::shared_ptr<const Block> make_block(Sum f) {
+  return std::make_shared<SumBlock>(f);
+}
+inline std::shared_ptr<const Block> make_block(ProductSum f) {
+  return std::make_shared<ProductSumBlock>(std::move(f));
+}
 
 }  // namespace fesd::nlp

@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "core/limits.hpp"
 #include "dcs/stewart.hpp"
 #include "discretization/fesd_interval.hpp"
 #include "fesd/error.hpp"
@@ -21,6 +22,7 @@
 #include "nlp/block_nlp.hpp"
 #include "nlp/nlp_solver.hpp"
 #include "nlp/sum_block.hpp"
+#include "ocp/ocp_checks.hpp"
 
 namespace fesd {
 namespace {
@@ -158,6 +160,7 @@ void check_input(const Ocp& ocp, const OcpOptions& o) {
     throw InvalidOption(fmt::format("ocp.T = {}: must be finite and > 0", ocp.T));
   if (ocp.N_stages < 1)
     throw InvalidOption(fmt::format("ocp.N_stages = {}: must be >= 1", ocp.N_stages));
+  if (std::string e = ocp_detail::step_length_error(ocp); !e.empty()) throw InvalidOption(e);
   if (!ocp.N_FE.empty() && static_cast<int>(ocp.N_FE.size()) != ocp.N_stages)
     throw InvalidOption(fmt::format("ocp.N_FE has {} entries, expected N_stages = {} (or none)",
                                     ocp.N_FE.size(), ocp.N_stages));
@@ -190,6 +193,8 @@ void check_input(const Ocp& ocp, const OcpOptions& o) {
       if (ocp.x0[i] < ocp.lbx0[i] || ocp.x0[i] > ocp.ubx0[i])
         throw InvalidModel(fmt::format("ocp.x0[{}] = {} is outside [lbx0, ubx0] = [{}, {}]", i,
                                        ocp.x0[i], ocp.lbx0[i], ocp.ubx0[i]));
+  if (auto e = ocp_detail::block_size_errors(ocp, o); !e.empty())
+    throw InvalidModel(fmt::format("{}", fmt::join(e, "; ")));
 }
 
 // ---- the NLP -----------------------------------------------------------------------------------
@@ -482,6 +487,51 @@ void extract(const OcpNlp& b, const Ocp& ocp, const std::vector<double>& w,
 }
 
 }  // namespace
+
+namespace ocp_detail {
+
+std::vector<std::string> block_size_errors(const Ocp& ocp, const OcpOptions& o) {
+  DiscretizationOptions d = o.discretization;
+  if (!ocp.N_FE.empty()) d.N_FE = *std::max_element(ocp.N_FE.begin(), ocp.N_FE.end());
+  std::vector<std::string> errors = FesdInterval::block_size_errors(ocp.model, d);
+  const Pss& m = ocp.model;
+  const int n_x = m.n_x(), n_u = m.n_u(), n_p = m.n_p(), limit = ad::kMaxInputs;
+  const OcpFunctions* f = ocp.functions.get();
+  // The blocks build() adds, with the same functors (their input counts need no function). The
+  // path constraints (n_x + n_u + n_p inputs) are smaller than the dynamics block.
+  if (f != nullptr && f->has_f_q()) {
+    const int k =
+        LagrangeTerm{f, std::vector<double>(o.discretization.n_s), n_x, n_u, n_p}.num_inputs();
+    if (k > limit)
+      errors.push_back(fmt::format(
+          "ocp.f_q = Lagrange term: integrated over one element it is one block of 1 + n_s n_x + "
+          "n_u + n_p = {} inputs (n_s = {}, n_x = {}); at most {} inputs per block are supported "
+          "(use fewer stages n_s or fewer states)",
+          k, o.discretization.n_s, n_x, limit));
+  }
+  if (f != nullptr && f->has_f_q_T() && MayerTerm{f, n_x, n_p}.num_inputs() > limit)
+    errors.push_back(fmt::format(
+        "ocp.f_q_T = Mayer term: one block of n_x + n_p = {} inputs; at most {} inputs per block "
+        "are supported (use fewer states)",
+        n_x + n_p, limit));
+  if (ocp.n_g_terminal > 0) {
+    const bool soft = ocp.terminal_constraint == TerminalConstraint::L1;
+    const int k = TerminalConstraintEq{f, n_x, n_p, ocp.n_g_terminal, soft}.num_inputs();
+    if (k > limit)
+      errors.push_back(fmt::format(
+          "ocp.g_terminal = {} terminal constraints: one block of n_x + n_p{} = {} inputs; at "
+          "most {} inputs per block are supported (use fewer states{})",
+          ocp.n_g_terminal, soft ? " + n_g_terminal (l1 slacks)" : "", k, limit,
+          soft ? " or terminal constraints, or relax_terminal_constraint = none" : ""));
+  }
+  return errors;
+}
+
+std::string step_length_error(const Ocp& ocp) {
+  return core::step_length_error("ocp.T", ocp.T, "ocp.N_stages", ocp.N_stages);
+}
+
+}  // namespace ocp_detail
 
 std::vector<std::string> validate(const OcpOptions& o) {
   std::vector<std::string> e = validate(o.discretization);

@@ -314,4 +314,93 @@ TEST(CliSolve, NothingWrittenUnlessAsked) {
   EXPECT_TRUE(fs::is_empty(dir.file("")));
 }
 
+// ---- robustness (issue 12, items 5 and 6) ----------------------------------------------------
+
+const std::string kCrossing = FESD_SOURCE_DIR "/examples/crossing.toml";
+
+/// Runs `command` with sh, returns its exit status (-1 if it did not exit normally).
+int run_shell(const std::string& command) {
+  const int status = std::system(command.c_str());
+  return status != -1 && WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+// REAL SOLVE (one short step, twice): an ipopt.opt in the working directory that would stop
+// every NLP (max_iter 0) and write IPOPT's full output to a file is not read.
+TEST(CliRobust, IpoptOptInTheWorkingDirectoryIsIgnored) {
+  TempDir plain, with_opt;
+  {
+    std::ofstream opt(with_opt.file("ipopt.opt"));
+    opt << "max_iter 0\nprint_level 12\noutput_file ipopt_out.txt\nfile_print_level 12\n";
+  }
+  auto simulate_in = [&](const TempDir& dir) {
+    const std::string cmd = "cd " + shell_quote(dir.file("")) + " && " + shell_quote(FESD_CLI) +
+                            " simulate " + shell_quote(kOscillator) +
+                            " --N_sim 1 --T_sim 0.05 --quiet --json r.json >out.txt 2>err.txt";
+    return run_shell(cmd);
+  };
+  ASSERT_EQ(simulate_in(plain), 0) << read_file(plain.file("err.txt"));
+  ASSERT_EQ(simulate_in(with_opt), 0) << read_file(with_opt.file("err.txt"));
+  const nlohmann::json a = nlohmann::json::parse(read_file(plain.file("r.json")));
+  const nlohmann::json b = nlohmann::json::parse(read_file(with_opt.file("r.json")));
+  EXPECT_EQ(a["x"], b["x"]);
+  EXPECT_EQ(a["h"], b["h"]);
+  EXPECT_FALSE(contains(read_file(with_opt.file("out.txt")), "Ipopt")) << "IPOPT printed";
+  std::vector<std::string> entries = with_opt.entries();
+  std::sort(entries.begin(), entries.end());
+  EXPECT_EQ(entries, (std::vector<std::string>{"err.txt", "ipopt.opt", "out.txt", "r.json"}));
+}
+
+TEST(CliRobust, HelpListsEveryExitCode) {
+  const CliRun r = run_cli({"--help"});
+  EXPECT_EQ(r.code, 0) << r.err;
+  for (const char* code :
+       {"0 solved", "1 not converged", "2 bad input", "3 I/O failure", "4 internal error"})
+    EXPECT_TRUE(contains(r.out, code)) << code << " in\n" << r.out;
+}
+
+TEST(CliRobust, FullStdoutIsAnIoError) {
+  // Issue 12, 6(f): `fesd check FILE > /dev/full` exited 0.
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  TempDir dir;
+  const int code = run_shell(shell_quote(FESD_CLI) + " check " + shell_quote(kCrossing) +
+                             " >/dev/full 2>" + shell_quote(dir.file("err")));
+  const std::string err = read_file(dir.file("err"));
+  EXPECT_EQ(code, 3) << err;
+  EXPECT_TRUE(
+      contains(err, "fesd: error: cannot write to standard output: No space left on device"))
+      << err;
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+}
+
+// REAL SOLVE (Example 3(a), 10 steps, well under a second).
+TEST(CliRobust, ClosedStdoutStillWritesTheOutputs) {
+  // Issue 12, 6(f): `fesd simulate ... | head -1` died of SIGPIPE before writing --json.
+  TempDir dir;
+  const std::string json = dir.file("r.json"), csv = dir.file("r.csv");
+  std::string cmd = "(";  // (string literal + string&& trips GCC 12's -Wrestrict)
+  cmd += shell_quote(FESD_CLI) + " simulate " + shell_quote(kCrossing) + " --json " +
+         shell_quote(json) + " --csv " + shell_quote(csv) + " 2>" + shell_quote(dir.file("err")) +
+         "; echo $? >" + shell_quote(dir.file("code")) + ") | head -1 >" +
+         shell_quote(dir.file("out"));
+  ASSERT_EQ(run_shell(cmd), 0);
+  const std::string err = read_file(dir.file("err"));
+  EXPECT_EQ(read_file(dir.file("code")), "3\n") << err;
+  EXPECT_TRUE(contains(err, "fesd: error: cannot write to standard output: Broken pipe")) << err;
+  EXPECT_TRUE(contains(read_file(dir.file("out")), "fesd ")) << "the first line got through";
+  ASSERT_TRUE(fs::exists(json));
+  EXPECT_EQ(nlohmann::json::parse(read_file(json))["status"], "success");
+  EXPECT_TRUE(fs::exists(csv));
+}
+
+TEST(CliRobust, ConstantToThePowerZeroChecks) {
+  // Issue 12, 6(a): F = [["2^0"], ["-1"]] crashed every command with SIGSEGV.
+  TempDir dir;
+  const std::string file = dir.file("power_zero.toml");
+  std::ofstream(file) << "[model]\nx = [\"x\"]\nc = [\"x\"]\nF = [[\"2^0\"], "
+                         "[\"pow(1, 0) - 2^(1-1) - 1\"]]\nx0 = [0.5]\n[simulation]\nT_sim = 1\n";
+  const CliRun r = run_cli({"check", file});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(contains(r.out, "is valid")) << r.out;
+}
+
 }  // namespace

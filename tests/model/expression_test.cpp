@@ -460,6 +460,48 @@ TEST(Expression, NonFiniteConstants) {
   EXPECT_EQ(error_of("x1/0"), "<no error>");
 }
 
+TEST(Expression, ConstantToThePowerZeroIsOne) {
+  // Issue 12, 6(a): folding c^0 recursed without end (SIGSEGV) for every constant c.
+  const char* cases[] = {"2^0",   "pow(1, 0)", "2^(1-1)", "0^0",       "(-3)^0",
+                         "pi^-0", "2^0 + 1",   "x^(2-2)", "pow(x, 0)", "1e300^0"};
+  for (const char* text : cases) {
+    const Expression e = parse(text, {"x"});
+    const double x = 0.25;
+    EXPECT_EQ(e.evaluate(&x), std::string(text) == "2^0 + 1" ? 2.0 : 1.0) << text;
+    EXPECT_TRUE(e.is_constant()) << text;
+    const Jet<8> j = e.evaluate<Jet<8>>(nullptr);
+    EXPECT_EQ(j.n, 0) << text;
+  }
+  EXPECT_EQ(eval("x^0 * y^(3-3)", {"x", "y"}, {0.0, -2.0}), 1.0);
+}
+
+TEST(Expression, LongTextIsShortenedInMessages) {
+  // Issue 12, 6(d): a 2 MB expression nested too deeply was repeated whole in the message.
+  const std::string deep = std::string(1000000, '(') + "x1" + std::string(1000000, ')');
+  const std::string message = error_of(deep);
+  EXPECT_NE(message.find("nested too deeply"), std::string::npos) << message.substr(0, 200);
+  EXPECT_LT(message.size(), 200U) << message.substr(0, 400);
+  EXPECT_NE(message.find("'" + std::string(60, '(') + "...'"), std::string::npos) << message;
+  // Every part of the text a message quotes is shortened: symbols, functions, numbers.
+  const std::string long_name(100000, 'q');
+  for (const std::string& text :
+       {long_name + " + x1", long_name + "(x1)", "x1 + 1" + std::string(100000, '0') + "e999",
+        "x1 + " + std::string(5000, '1') + "/0", "x1 " + long_name}) {
+    const std::string m = error_of(text);
+    EXPECT_LT(m.size(), 400U) << m.substr(0, 400);
+    EXPECT_EQ(m.find('\n'), std::string::npos);
+  }
+  // Up to 60 characters are quoted whole, UTF-8 characters are not cut.
+  EXPECT_ERROR("x1 +* 2", "cannot parse 'x1 +* 2'");
+  const std::string sixty = std::string(58, 'x') + " $";
+  EXPECT_NE(error_of(sixty).find("'" + sixty + "'"), std::string::npos) << error_of(sixty);
+  const std::string utf8 = std::string(59, 'x') + "\u00b7\u00b7 $";
+  EXPECT_NE(error_of(utf8).find("'" + std::string(59, 'x') + "\u00b7...'"), std::string::npos)
+      << error_of(utf8);
+  EXPECT_EQ(shorten(std::string(61, 'a')), std::string(60, 'a') + "...");
+  EXPECT_EQ(shorten("a\nb"), "a b");
+}
+
 TEST(Expression, ErrorWithoutWhere) {
   try {
     Expression::parse("q", {}, "");
