@@ -15,6 +15,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "core/option_registry.hpp"
 #include "core/report.hpp"
 #include "dcs/stewart.hpp"
 #include "discretization/fesd_interval.hpp"
@@ -155,9 +156,8 @@ IntegratorResult integrate(const Pss& model, const Eigen::VectorXd& x0_in, doubl
     throw InvalidModel(
         fmt::format("x0 has {} entries, expected n_x = {}", x0_in.size(), model.n_x()));
   check_finite(x0_in, "x0");
-  if (!std::isfinite(T_sim) || T_sim <= 0)
-    throw InvalidOption(fmt::format("T_sim = {}: must be finite and > 0", T_sim));
-  if (N_sim < 1) throw InvalidOption(fmt::format("N_sim = {}: must be >= 1", N_sim));
+  if (const auto e = registry::validate_simulation(T_sim, N_sim); !e.empty())
+    throw InvalidOption(registry::join(e));
   const Eigen::VectorXd u = u_in.size() == 0 ? Eigen::VectorXd::Zero(model.n_u()) : u_in;
   const Eigen::VectorXd p = p_in.size() == 0 ? model.p_default : p_in;
   if (u.size() != model.n_u())
