@@ -33,6 +33,7 @@
 #pragma once
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -69,6 +70,9 @@ enum class TerminalConstraint {
   /// g_i - ubg_i <= s_i and lbg_i - g_i <= s_i (the paper's rho ||q(T) - q_final||_1 of (61)).
   L1,
 };
+/// Problem-file key `relax_terminal_constraint`: "none" (Hard), "ell_1" (L1).
+std::string_view to_string(TerminalConstraint v);
+bool parse(std::string_view name, TerminalConstraint& out);
 
 /// An optimal control problem. Vectors left empty mean "none" (bounds) or "zero" (guesses).
 struct Ocp {
@@ -99,6 +103,9 @@ enum class OcpInitialization {
   Constant,    ///< x0 at every point, algebraic variables from LP(x0) (the paper's Sect. 5.2)
   Simulation,  ///< a forward simulation from x0 with u_guess on the same grid (Sect. 4.5)
 };
+/// Problem-file key `initialization`: "constant", "simulation".
+std::string_view to_string(OcpInitialization v);
+bool parse(std::string_view name, OcpInitialization& out);
 
 struct OcpOptions {
   /// Default step equilibration for OCPs: l2_relaxed, not the integrator's heuristic_mean, whose

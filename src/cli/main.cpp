@@ -39,6 +39,7 @@
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
+#include "core/option_registry.hpp"
 #include "fesd/error.hpp"
 #include "fesd/integrator.hpp"
 #include "fesd/io.hpp"
@@ -123,89 +124,70 @@ void print_error(std::string_view message) {
 
 // ---- overrides -------------------------------------------------------------------------------
 
-/// Which subcommands offer an override: simulation files, OCP files, or both.
-enum class Scope { Simulation, Ocp, Both };
+/// Which subcommands offer an override: simulation files, OCP files, or both (`check`).
+using Scope = fesd::registry::Use;
 
-struct OverrideKey {
-  const char* key;    ///< apply_override key
-  const char* names;  ///< CLI11 option names
-  const char* help;
-  Scope scope;
-};
+constexpr const char* kOverridesFooter =
+    "Overrides act as if written in the problem file. A key may be qualified by its table "
+    "(--discretization.n_s 3); --ipopt.NAME VALUE or --ipopt NAME=VALUE sets any IPOPT option.";
 
-constexpr OverrideKey kOverrideKeys[] = {
-    {"T_sim", "--T_sim", "[simulation] end time T_sim > 0", Scope::Simulation},
-    {"N_sim", "--N_sim", "[simulation] number of integration steps", Scope::Simulation},
-    {"T", "--T", "[ocp] horizon T > 0", Scope::Ocp},
-    {"N_stages", "--N_stages", "[ocp] number of control intervals", Scope::Ocp},
-    {"relax_terminal_constraint", "--relax_terminal_constraint",
-     "[ocp] none or ell_1 (penalty rho_terminal)", Scope::Ocp},
-    {"rho_terminal", "--rho_terminal", "[ocp] weight of the ell_1 terminal penalty", Scope::Ocp},
-    {"initialization", "--initialization", "[ocp] initial guess: constant or simulation",
-     Scope::Ocp},
-    {"constraints_at_stages", "--constraints_at_stages",
-     "[ocp] 1: path constraints and state bounds also at the RK stage points", Scope::Ocp},
-    {"rk_scheme", "--rk_scheme",
-     "radau_iia, gauss_legendre, lobatto_iiia, lobatto_iiic or explicit_rk", Scope::Both},
-    {"n_s", "--n_s", "Runge-Kutta stages per finite element", Scope::Both},
-    {"N_finite_elements", "--N_finite_elements,--N_FE",
-     "finite elements per integration step (per control interval for OCPs)", Scope::Both},
-    {"use_fesd", "--use_fesd", "1: FESD (32), 0: standard time-stepping (26)", Scope::Both},
-    {"cross_comp_mode", "--cross_comp_mode", "sparse, stage_sum, element or neighbor", Scope::Both},
-    {"step_equilibration", "--step_equilibration",
-     "none, eta, eta_tanh, heuristic_mean or l2_relaxed", Scope::Both},
-    {"stage_lambda_sign", "--stage_lambda_sign",
-     "where lambda >= 0 holds: all (stages), boundary (element ends) or auto", Scope::Both},
-    {"gamma_h", "--gamma_h", "step size freedom in (0, 1]", Scope::Both},
-    {"rho_h", "--rho_h", "weight of the heuristic_mean penalty", Scope::Both},
-    {"pin_sliding_exits", "--pin_sliding_exits",
-     "1: solve once more with sliding exits pinned where theta has not reached 0", Scope::Both},
-    {"mpcc_mode", "--mpcc_mode",
-     "scholtes_ineq, scholtes_eq, fischer_burmeister, ell_1_penalty or elastic_ineq", Scope::Both},
-    {"sigma_0", "--sigma_0", "first homotopy relaxation", Scope::Both},
-    {"homotopy_update_slope", "--homotopy_update_slope", "sigma_{k+1} = slope * sigma_k",
-     Scope::Both},
-    {"sigma_N", "--sigma_N", "smallest sigma", Scope::Both},
-    {"complementarity_tol", "--complementarity_tol", "stop when the residual is below this",
-     Scope::Both},
-    {"N_homotopy", "--N_homotopy", "maximum number of NLPs per step", Scope::Both},
-    {"intermediate_tol", "--intermediate_tol",
-     "IPOPT tol of the NLPs with sigma > 10 complementarity_tol (0: tol everywhere)", Scope::Both},
-    {"tol", "--tol", "IPOPT tol", Scope::Both},
-    {"acceptable_tol", "--acceptable_tol", "IPOPT acceptable_tol", Scope::Both},
-    {"max_iter", "--max_iter", "IPOPT iterations per NLP", Scope::Both},
-    {"print_level", "--print_level", "IPOPT print_level 0..12", Scope::Both},
-};
-constexpr std::size_t kNumOverrideKeys = sizeof kOverrideKeys / sizeof kOverrideKeys[0];
+/// "Overrides [discretization]": one --help group per problem-file table.
+std::string override_group(fesd::registry::Table table) {
+  return fmt::format("Overrides [{}]", fesd::registry::to_string(table));
+}
 
-/// The override options of one subcommand and their values after parsing.
+/// The override options of one subcommand, made from the option registry, and their values after
+/// parsing.
 struct Overrides {
-  std::vector<std::string> values = std::vector<std::string>(kNumOverrideKeys);
-  std::vector<CLI::Option*> options = std::vector<CLI::Option*>(kNumOverrideKeys, nullptr);
+  std::vector<const fesd::registry::Option*> keys;
+  std::vector<std::string> values;
+  std::vector<CLI::Option*> options;
   std::vector<std::string> ipopt;
 
   /// Adds the options of `scope` (Both: every option, for `check`, which reads either kind).
   void add_to(CLI::App& app, Scope scope) {
-    for (std::size_t i = 0; i < kNumOverrideKeys; ++i) {
-      const Scope s = kOverrideKeys[i].scope;
-      if (scope != Scope::Both && s != Scope::Both && s != scope) continue;
-      options[i] = app.add_option(kOverrideKeys[i].names, values[i], kOverrideKeys[i].help)
+    for (const fesd::registry::Option& o : fesd::registry::all())
+      if (o.overridable && fesd::registry::has(o, scope)) keys.push_back(&o);
+    values.resize(keys.size());
+    options.resize(keys.size(), nullptr);
+    for (std::size_t i = 0; i < keys.size(); ++i) {
+      const fesd::registry::Option& o = *keys[i];
+      std::string names = fmt::format("--{}", o.key);
+      if (!o.alias.empty()) names += fmt::format(",--{}", o.alias);
+      options[i] = app.add_option(names, values[i], fesd::registry::help_text(o))
+                       ->type_name(type_name(o.kind))
                        ->multi_option_policy(CLI::MultiOptionPolicy::TakeLast)
-                       ->group("Overrides (as if written in the problem file)");
+                       ->group(override_group(o.table));
     }
     app.add_option("--ipopt", ipopt, "any IPOPT option, NAME=VALUE (repeatable)")
         ->type_name("NAME=VALUE")
         ->allow_extra_args(false)
-        ->group("Overrides (as if written in the problem file)");
+        ->group(override_group(fesd::registry::Table::Ipopt));
+    app.footer(kOverridesFooter);
+  }
+
+  static const char* type_name(fesd::registry::Kind kind) {
+    switch (kind) {
+      case fesd::registry::Kind::Int:
+        return "INT";
+      case fesd::registry::Kind::Double:
+        return "NUMBER";
+      case fesd::registry::Kind::Bool:
+        return "BOOL";
+      case fesd::registry::Kind::Enum:
+        return "NAME";
+      default:
+        return "VALUE";
+    }
   }
 
   /// (key, value) pairs in a fixed order, the --ipopt ones last (as keys "ipopt.NAME", so that
   /// any IPOPT option name is accepted).
   std::vector<std::pair<std::string, std::string>> pairs() const {
     std::vector<std::pair<std::string, std::string>> out;
-    for (std::size_t i = 0; i < kNumOverrideKeys; ++i) {
+    for (std::size_t i = 0; i < keys.size(); ++i) {
       if (options[i] != nullptr && options[i]->count() > 0) {
-        out.emplace_back(kOverrideKeys[i].key, values[i]);
+        out.emplace_back(keys[i]->key, values[i]);
       }
     }
     for (const std::string& item : ipopt) {
@@ -218,6 +200,40 @@ struct Overrides {
     return out;
   }
 };
+
+/// The command line for CLI11 (reversed, without the program name), with the qualified override
+/// forms of docs/problem-files.md rewritten: "--TABLE.KEY" -> "--KEY" for a registry key of
+/// TABLE, and "--ipopt.NAME VALUE" / "--ipopt.NAME=VALUE" -> "--ipopt NAME=VALUE" for any other
+/// IPOPT option. Nothing after "--" is rewritten.
+std::vector<std::string> cli11_args(int argc, char** argv) {
+  std::vector<std::string> args;
+  bool options_end = false;
+  for (int i = 1; i < argc; ++i) {
+    std::string arg = argv[i];
+    const std::size_t dot = arg.find('.');
+    const std::size_t eq = arg.find('=');
+    if (arg == "--") options_end = true;
+    if (options_end || arg.rfind("--", 0) != 0 || dot == std::string::npos || eq < dot) {
+      args.push_back(std::move(arg));
+      continue;
+    }
+    const std::string table = arg.substr(2, dot - 2);
+    const std::string key = arg.substr(dot + 1, eq == std::string::npos ? eq : eq - dot - 1);
+    const std::string rest = eq == std::string::npos ? "" : arg.substr(eq);  // "=VALUE" or ""
+    const fesd::registry::Option* o = nullptr;
+    for (const fesd::registry::Option& x : fesd::registry::all())
+      if (fesd::registry::to_string(x.table) == table && (x.key == key || x.alias == key)) o = &x;
+    if (o != nullptr && o->overridable) {
+      args.push_back("--" + key + rest);
+    } else if (table == "ipopt" && !key.empty() && (!rest.empty() || i + 1 < argc)) {
+      args.push_back("--ipopt");
+      args.push_back(key + (rest.empty() ? "=" + std::string(argv[++i]) : rest));
+    } else {
+      args.push_back(std::move(arg));
+    }
+  }
+  return {args.rbegin(), args.rend()};
+}
 
 /// Applies the overrides. apply_override re-validates after every key, so a combination that is
 /// valid only as a whole (e.g. rk_scheme = lobatto_iiia together with n_s = 2 when the file has
@@ -613,7 +629,8 @@ int run(int argc, char** argv) {
   }
 
   try {
-    app.parse(argc, argv);
+    std::vector<std::string> args = cli11_args(argc, argv);
+    app.parse(args);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
     print_error(std::string(e.what()) + " (see fesd --help)");

@@ -277,43 +277,6 @@ void check_range(RkScheme scheme, int n_s) {
 
 }  // namespace
 
-std::string_view to_string(RkScheme s) {
-  switch (s) {
-    case RkScheme::RadauIIA:
-      return "radau_iia";
-    case RkScheme::GaussLegendre:
-      return "gauss_legendre";
-    case RkScheme::LobattoIIIA:
-      return "lobatto_iiia";
-    case RkScheme::LobattoIIIC:
-      return "lobatto_iiic";
-    case RkScheme::ExplicitRK:
-      return "explicit_rk";
-  }
-  return "unknown";
-}
-
-bool parse(std::string_view name, RkScheme& out) {
-  struct Entry {
-    std::string_view lower, upper;
-    RkScheme scheme;
-  };
-  static constexpr Entry kEntries[] = {
-      {"radau_iia", "RADAU_IIA", RkScheme::RadauIIA},
-      {"gauss_legendre", "GAUSS_LEGENDRE", RkScheme::GaussLegendre},
-      {"lobatto_iiia", "LOBATTO_IIIA", RkScheme::LobattoIIIA},
-      {"lobatto_iiic", "LOBATTO_IIIC", RkScheme::LobattoIIIC},
-      {"explicit_rk", "EXPLICIT_RK", RkScheme::ExplicitRK},
-  };
-  for (const Entry& e : kEntries) {
-    if (name == e.lower || name == e.upper) {
-      out = e.scheme;
-      return true;
-    }
-  }
-  return false;
-}
-
 std::string Tableau::name() const {
   std::string label;
   switch (scheme) {

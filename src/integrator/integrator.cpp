@@ -15,7 +15,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include "core/limits.hpp"
+#include "core/option_registry.hpp"
 #include "dcs/stewart.hpp"
 #include "discretization/fesd_interval.hpp"
 #include "fesd/error.hpp"
@@ -127,11 +127,8 @@ void check_input(const Pss& model, const Eigen::VectorXd& x0, double T_sim, int 
   if (x0.size() != model.n_x())
     throw InvalidModel(fmt::format("x0 has {} entries, expected n_x = {}", x0.size(), model.n_x()));
   check_finite(x0, "x0");
-  if (!std::isfinite(T_sim) || T_sim <= 0)
-    throw InvalidOption(fmt::format("T_sim = {}: must be finite and > 0", T_sim));
-  if (N_sim < 1) throw InvalidOption(fmt::format("N_sim = {}: must be >= 1", N_sim));
-  if (std::string e = core::step_length_error("T_sim", T_sim, "N_sim", N_sim); !e.empty())
-    throw InvalidOption(e);
+  if (const auto e = registry::validate_simulation(T_sim, N_sim); !e.empty())
+    throw InvalidOption(registry::join(e));
   if (auto e = discretization::FesdInterval::block_size_errors(model, options.discretization);
       !e.empty())
     throw InvalidModel(fmt::format("{}", fmt::join(e, "; ")));

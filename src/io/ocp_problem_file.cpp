@@ -6,8 +6,8 @@
 // Reading order: syntax, top-level keys, [model] names and expressions, [ocp] keys and
 // expressions (which decide, with the model's, whether a clock state is needed), [model] x0 and the
 // Pss, the [ocp] bounds and guesses, [ocp] scalar options, [discretization] (N_finite_elements may
-// be a list, one per control interval), [homotopy], [ipopt], and finally the ranges of
-// validate(OcpOptions) and of the OCP's own rules, all reported together.
+// be a list, one per control interval), [homotopy], [ipopt], and finally the OCP's input rules
+// (src/ocp/ocp_input.cpp, shared with fesd::solve): the data's first, then every option rule.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -25,8 +25,9 @@
 #include "fesd/error.hpp"
 #include "fesd/problem_file.hpp"
 #include "io/ocp_expression_functions.hpp"
+#include "io/option_target.hpp"
 #include "io/problem_file_reader.hpp"
-#include "ocp/ocp_checks.hpp"
+#include "ocp/ocp_input.hpp"
 
 namespace fesd {
 namespace {
@@ -37,94 +38,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 constexpr std::array<std::string_view, 7> kTopKeys{"name",           "description", "model", "ocp",
                                                    "discretization", "homotopy",    "ipopt"};
-// [ocp] keys that are not scalar options (kOcpOptions below): expressions, bounds, guesses.
-constexpr std::array<std::string_view, 15> kOcpVectorKeys{
-    "f_q", "f_q_T", "g_path", "lbg_path", "ubg_path", "g_terminal", "lbg_terminal", "ubg_terminal",
-    "lbx", "ubx",   "lbu",    "ubu",      "u_guess",  "lbx0",       "ubx0"};
-
-using Op = OcpProblem;
-using Ov = OptionValue;
-
-constexpr std::array<OptionSpec<Op>, 6> kOcpOptions{{
-    {"ocp", "T", Kind::Double, [](Op& q, const Ov& v) { q.ocp.T = v.d; }},
-    {"ocp", "N_stages", Kind::Int, [](Op& q, const Ov& v) { q.ocp.N_stages = v.i; }},
-    {"ocp", "relax_terminal_constraint", Kind::TerminalMode,
-     [](Op& q, const Ov& v) {
-       q.ocp.terminal_constraint =
-           v.name == "ell_1" ? TerminalConstraint::L1 : TerminalConstraint::Hard;
-     }},
-    {"ocp", "rho_terminal", Kind::Double, [](Op& q, const Ov& v) { q.ocp.rho_terminal = v.d; }},
-    {"ocp", "initialization", Kind::InitMode,
-     [](Op& q, const Ov& v) {
-       q.options.initialization =
-           v.name == "simulation" ? OcpInitialization::Simulation : OcpInitialization::Constant;
-     }},
-    {"ocp", "constraints_at_stages", Kind::Bool,
-     [](Op& q, const Ov& v) { q.options.constraints_at_stages = v.b; }},
-}};
-constexpr auto kOptions = concat(kOcpOptions, solver_option_specs<Op>());
-constexpr std::array<std::string_view, 4> kTables{"ocp", "discretization", "homotopy", "ipopt"};
-
-std::vector<std::string_view> keys_of(std::string_view table) {
-  if (table != "ocp") return keys_of_table(kOptions, table);
-  // T and N_stages first, as in the documentation's table.
-  std::vector<std::string_view> keys{"T", "N_stages"};
-  keys.insert(keys.end(), kOcpVectorKeys.begin(), kOcpVectorKeys.end());
-  for (std::string_view k : keys_of_table(kOptions, "ocp"))
-    if (std::find(keys.begin(), keys.end(), k) == keys.end()) keys.push_back(k);
-  return keys;
-}
-
-std::string list_of_ints(const std::vector<int>& v) {
-  std::string s;
-  for (int i : v) s += fmt::format("{}{}", s.empty() ? "" : ", ", i);
-  return "[" + s + "]";
-}
-
-/// Rules of an OcpProblem that validate(OcpOptions) does not cover. Messages start with the
-/// "table.key = value" they are about, so that file errors can point at its line.
-std::vector<std::string> validate_ocp(const OcpProblem& q) {
-  std::vector<std::string> e;
-  const Ocp& o = q.ocp;
-  if (!(std::isfinite(o.T) && o.T > 0)) e.push_back(fmt::format("ocp.T = {}: must be > 0", o.T));
-  if (o.N_stages < 1) e.push_back(fmt::format("ocp.N_stages = {}: must be >= 1", o.N_stages));
-  if (std::string s = ocp_detail::step_length_error(o); !s.empty()) e.push_back(std::move(s));
-  if (!o.N_FE.empty()) {
-    if (static_cast<int>(o.N_FE.size()) != o.N_stages)
-      e.push_back(fmt::format(
-          "discretization.N_finite_elements = {}: wrong length (expected {} {}, one per control "
-          "interval (N_stages = {}), or one integer for all intervals)",
-          list_of_ints(o.N_FE), o.N_stages, o.N_stages == 1 ? "entry" : "entries", o.N_stages));
-    const bool fesd = q.options.discretization.use_fesd;
-    for (std::size_t k = 0; k < o.N_FE.size(); ++k) {
-      const int n = o.N_FE[k];
-      if (n < 1 || n > 1000)
-        e.push_back(
-            fmt::format("discretization.N_finite_elements[{}] = {}: must be in 1..1000", k, n));
-      else if (fesd && n < 2)
-        e.push_back(fmt::format(
-            "discretization.N_finite_elements[{}] = {}: FESD needs >= 2 finite elements (with one "
-            "there is no step size to move); use 2 or use_fesd = false",
-            k, n));
-    }
-  }
-  if (!(std::isfinite(o.rho_terminal) && o.rho_terminal > 0))
-    e.push_back(fmt::format("ocp.rho_terminal = {}: must be > 0", o.rho_terminal));
-  if (o.terminal_constraint == TerminalConstraint::L1 && o.n_g_terminal == 0)
-    e.push_back(
-        "ocp.relax_terminal_constraint = ell_1: there are no terminal constraints to relax "
-        "(expected g_terminal, or relax_terminal_constraint = \"none\")");
-  return e;
-}
-
-std::vector<std::string> validate_all(const OcpProblem& q) {
-  std::vector<std::string> e = validate_ocp(q);
-  for (std::string& s : validate(q.options)) e.push_back(std::move(s));
-  if (e.empty())  // the limits of the NLP's blocks, docs/problem-files.md "Limits"
-    for (std::string& s : ocp_detail::block_size_errors(q.ocp, q.options))
-      e.push_back(std::move(s));
-  return e;
-}
+constexpr registry::Use kKind = registry::Use::Ocp;
 
 /// A list of expressions (g_path, g_terminal).
 std::vector<expr::Expression> read_expressions(const Reader& r, const toml::node& n,
@@ -166,21 +80,12 @@ Bounds read_bounds(const Reader& r, const toml::table& t, std::string_view lb_ke
   return b;
 }
 
-/// Fills an absent side: `lb_default` / `ub_default` if neither is given, else unbounded. Then
-/// checks lb <= ub entry by entry.
-void complete_bounds(const Reader& r, Bounds& b, std::string_view lb_key, std::string_view ub_key,
-                     int n, double lb_default, double ub_default) {
+/// Fills an absent side: `lb_default` / `ub_default` if neither is given, else unbounded. lb <= ub
+/// is an input rule of the OCP (src/ocp/ocp_input.cpp).
+void complete_bounds(Bounds& b, int n, double lb_default, double ub_default) {
   const bool none = b.lb_node == nullptr && b.ub_node == nullptr;
   if (b.lb_node == nullptr) b.lb = Eigen::VectorXd::Constant(n, none ? lb_default : -kInf);
   if (b.ub_node == nullptr) b.ub = Eigen::VectorXd::Constant(n, none ? ub_default : kInf);
-  for (int i = 0; i < n; ++i)
-    if (b.lb[i] > b.ub[i]) {
-      const toml::node* at = b.lb_node != nullptr ? b.lb_node : b.ub_node;
-      r.fail(at->source(), "",
-             fmt::format("ocp.{}[{}] = {} > ocp.{}[{}] = {}: empty bounds (expected {} <= {})",
-                         lb_key, i, format_number(b.lb[i]), ub_key, i, format_number(b.ub[i]),
-                         lb_key, ub_key));
-    }
 }
 
 /// [discretization] N_finite_elements: one integer for all control intervals, or a list.
@@ -200,26 +105,24 @@ void read_N_FE(const Reader& r, const toml::node& n, OcpProblem& problem) {
     problem.ocp.N_FE.push_back(r.integer((*a)[i], index(path, i)));
 }
 
+/// The options of [ocp], [discretization], [homotopy] and [ipopt], then every input rule of the
+/// OCP (src/ocp/ocp_input.cpp): the problem's data first (ProblemFileError), then the options
+/// (InvalidOption), each message at the line of the key it names.
 void read_options(const Reader& r, const toml::table& root, OcpProblem& problem) {
-  for (std::string_view table_name : kTables) {
-    const toml::node* tn = root.get(table_name);
+  const registry::OptionTarget target = target_of(problem);
+  static constexpr std::array<std::string_view, 1> kPerInterval{"N_finite_elements"};
+  for (registry::Table table : registry::tables(kKind)) {
+    const toml::node* tn = root.get(registry::to_string(table));
     if (tn == nullptr) continue;  // [ocp] is checked before
-    const toml::table& t = r.table(*tn, table_name);
-    const std::vector<std::string_view> keys = keys_of(table_name);
-    if (table_name != "ipopt") r.check_keys(t, keys, table_name);
-    for (const OptionSpec<Op>& o : kOptions) {
-      if (o.table != table_name) continue;
-      const toml::node* n = t.get(o.key);
-      if (n == nullptr) continue;
-      if (o.key == "N_finite_elements")
-        read_N_FE(r, *n, problem);
-      else
-        o.set(problem, read_option(r, o.table, o.key, o.kind, *n));
-    }
-    if (table_name == "ipopt") read_ipopt_extra(r, t, keys, problem.options.nlp.extra);
+    const toml::table& t = r.table(*tn, registry::to_string(table));
+    check_table_keys(r, t, table, kKind);
+    read_option_table(r, t, table, kKind, target, problem.options.nlp.extra, kPerInterval);
+    if (table == registry::Table::Discretization)
+      if (const toml::node* n = t.get(kPerInterval[0])) read_N_FE(r, *n, problem);
   }
-  const std::vector<std::string> errors = validate_all(problem);
-  if (!errors.empty()) throw_validation_errors(r, root, errors);
+  const ocp_detail::OcpInputErrors errors = ocp_detail::check_input(problem.ocp, problem.options);
+  if (!errors.data.empty()) throw ProblemFileError(located(r, root, errors.data));
+  if (!errors.options.empty()) throw_validation_errors(r, root, errors.options);
 }
 
 /// v with `value` appended (the clock's entry).
@@ -268,9 +171,8 @@ OcpProblem parse_ocp_problem(std::string_view toml_text, std::string_view source
     r.fail(x0->source(), "ocp.x0",
            "x0 belongs in [model] (the initial state; with lbx0/ubx0 in [ocp] it is the guess of "
            "a free initial state)");
-  r.check_keys(t, keys_of("ocp"), "ocp");
-  if (t.get("T") == nullptr)
-    r.fail(t.source(), "ocp", "missing key 'T' (expected the length of the horizon, a number > 0)");
+  check_table_keys(r, t, registry::Table::Ocp, kKind);
+  check_required_key(r, t, registry::Table::Ocp);
   OcpExpressions e;
   if (const toml::node* n = t.get("f_q")) e.f_q = r.expression(*n, "ocp.f_q", sym.all);
   if (const toml::node* n = t.get("f_q_T")) {
@@ -295,7 +197,6 @@ OcpProblem parse_ocp_problem(std::string_view toml_text, std::string_view source
     has_clock = has_clock || std::any_of(list->begin(), list->end(), reads_time);
 
   // [model] x0 and the Pss; the OCP starts at t = 0.
-  const toml::node* x0_node = spec.table->get("x0");
   BuiltModel built = build_model(r, std::move(spec), has_clock, 0.0);
   Ocp& ocp = problem.ocp;
   ocp.model = std::move(built.model);
@@ -315,41 +216,27 @@ OcpProblem parse_ocp_problem(std::string_view toml_text, std::string_view source
     throw InvalidModel(fmt::format("{}: {}", r.at(t.source()), err.what()));
   }
 
-  // Bounds and guesses. The clock (if any) is unbounded and starts at 0.
+  // Bounds and guesses; their rules (lb <= ub, guesses within bounds) are checked with the
+  // options (read_options). The clock (if any) is unbounded and starts at 0.
   const std::string per_state = "one per state in model.x";
   const std::string per_control = "one per control in model.u";
   Bounds x = read_bounds(r, t, "lbx", "ubx", n_x_user, per_state);
   if (x.lb_node != nullptr || x.ub_node != nullptr) {
-    complete_bounds(r, x, "lbx", "ubx", n_x_user, -kInf, kInf);
+    complete_bounds(x, n_x_user, -kInf, kInf);
     ocp.lbx = has_clock ? append(x.lb, -kInf) : x.lb;
     ocp.ubx = has_clock ? append(x.ub, kInf) : x.ub;
   }
   Bounds u = read_bounds(r, t, "lbu", "ubu", n_u, per_control);
   if (u.lb_node != nullptr || u.ub_node != nullptr) {
-    complete_bounds(r, u, "lbu", "ubu", n_u, -kInf, kInf);
+    complete_bounds(u, n_u, -kInf, kInf);
     ocp.lbu = u.lb;
     ocp.ubu = u.ub;
   }
-  if (const toml::node* n = t.get("u_guess")) {
+  if (const toml::node* n = t.get("u_guess"))
     ocp.u_guess = r.vector(*n, "ocp.u_guess", n_u, per_control);
-    for (int i = 0; i < n_u && ocp.lbu.size() > 0; ++i)
-      if (ocp.u_guess[i] < ocp.lbu[i] || ocp.u_guess[i] > ocp.ubu[i])
-        r.fail(n->source(), index("ocp.u_guess", static_cast<std::size_t>(i)),
-               fmt::format("{} is outside [lbu, ubu] = [{}, {}] (expected a guess within the "
-                           "control bounds)",
-                           format_number(ocp.u_guess[i]), format_number(ocp.lbu[i]),
-                           format_number(ocp.ubu[i])));
-  }
   Bounds x0 = read_bounds(r, t, "lbx0", "ubx0", n_x_user, per_state);
   if (x0.lb_node != nullptr || x0.ub_node != nullptr) {
-    complete_bounds(r, x0, "lbx0", "ubx0", n_x_user, -kInf, kInf);
-    for (int i = 0; i < n_x_user; ++i)
-      if (ocp.x0[i] < x0.lb[i] || ocp.x0[i] > x0.ub[i])
-        r.fail(x0_node->source(), index("model.x0", static_cast<std::size_t>(i)),
-               fmt::format("{} is outside [lbx0, ubx0] = [{}, {}] (with lbx0/ubx0, model.x0 is "
-                           "the guess of the free initial state and must satisfy its bounds)",
-                           format_number(ocp.x0[i]), format_number(x0.lb[i]),
-                           format_number(x0.ub[i])));
+    complete_bounds(x0, n_x_user, -kInf, kInf);
     ocp.lbx0 = has_clock ? append(x0.lb, 0.0) : x0.lb;
     ocp.ubx0 = has_clock ? append(x0.ub, 0.0) : x0.ub;
   }
@@ -357,12 +244,12 @@ OcpProblem parse_ocp_problem(std::string_view toml_text, std::string_view source
   // (nosnoc's convention) unless bounds are given. One bound alone leaves the other side open.
   Bounds gp = read_bounds(r, t, "lbg_path", "ubg_path", ocp.n_g_path,
                           "one per path constraint in g_path", "g_path");
-  complete_bounds(r, gp, "lbg_path", "ubg_path", ocp.n_g_path, -kInf, 0.0);
+  complete_bounds(gp, ocp.n_g_path, -kInf, 0.0);
   ocp.lbg_path = gp.lb;
   ocp.ubg_path = gp.ub;
   Bounds gt = read_bounds(r, t, "lbg_terminal", "ubg_terminal", ocp.n_g_terminal,
                           "one per terminal constraint in g_terminal", "g_terminal");
-  complete_bounds(r, gt, "lbg_terminal", "ubg_terminal", ocp.n_g_terminal, 0.0, 0.0);
+  complete_bounds(gt, ocp.n_g_terminal, 0.0, 0.0);
   ocp.lbg_terminal = gt.lb;
   ocp.ubg_terminal = gt.ub;
 
@@ -379,37 +266,21 @@ ProblemKind problem_file_kind(const std::string& path) {
   return root.get("ocp") != nullptr ? ProblemKind::Ocp : ProblemKind::Simulation;
 }
 
-void apply_override(OcpProblem& problem, std::string_view key_in, std::string_view value_in) {
-  const OverrideArg arg = parse_override_arg(key_in, value_in, kTables);
-  const std::string_view table = arg.table, key = arg.key;
-  const std::string& value = arg.value;
-  const std::string& head = arg.head;
-
+void apply_override(OcpProblem& problem, std::string_view key, std::string_view value) {
+  const OverrideArg arg = parse_override_arg(key, value, kKind);
   OcpProblem updated = problem;
-  const OptionSpec<Op>* spec = find_option(kOptions, table, key);
-
-  if (spec != nullptr) {
-    spec->set(updated, override_value(spec->kind, value, head));
+  if (set_scalar_override(arg, target_of(updated))) {
     // One number for every control interval replaces a per-interval list.
-    if (spec->key == "N_finite_elements") updated.ocp.N_FE.clear();
-  } else if (table == "ipopt" && !key.empty()) {
-    set_ipopt_option(updated.options.nlp.extra, key, value);
+    if (arg.option->key == "N_finite_elements") updated.ocp.N_FE.clear();
+  } else if (arg.table == "ipopt" && !arg.key.empty()) {
+    set_ipopt_option(updated.options.nlp.extra, arg.key, arg.value);
   } else {
-    std::vector<std::string_view> valid;
-    for (const OptionSpec<Op>& o : kOptions)
-      if (table.empty() || o.table == table) valid.push_back(o.key);
-    if (table.empty() || table == "discretization") valid.push_back("N_FE");
-    std::string hint = key_hint(key, valid);
-    if (std::find(kOcpVectorKeys.begin(), kOcpVectorKeys.end(), key) != kOcpVectorKeys.end())
-      hint = "(expressions, bounds and guesses can only be set in the file)";
-    override_error(head, fmt::format("unknown option '{}' {}", key, hint));
+    unknown_override(arg, kKind);
   }
 
-  const std::vector<std::string> errors = validate_all(updated);
-  if (!errors.empty())
-    throw_override_errors(
-        head, spec != nullptr ? fmt::format("{}.{}", spec->table, spec->key) : std::string{},
-        errors);
+  ocp_detail::OcpInputErrors errors = ocp_detail::check_input(updated.ocp, updated.options);
+  for (std::string& e : errors.data) errors.options.push_back(std::move(e));
+  if (!errors.options.empty()) throw_override_errors(arg, errors.options);
   problem = std::move(updated);
 }
 

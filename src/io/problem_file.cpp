@@ -23,6 +23,7 @@
 #include "discretization/fesd_interval.hpp"
 #include "fesd/error.hpp"
 #include "fesd/problem_file.hpp"
+#include "io/option_target.hpp"
 #include "io/problem_file_reader.hpp"
 
 namespace fesd {
@@ -32,70 +33,30 @@ using namespace io_detail;
 
 constexpr std::array<std::string_view, 7> kTopKeys{
     "name", "description", "model", "simulation", "discretization", "homotopy", "ipopt"};
-constexpr std::array<std::string_view, 4> kSimulationKeys{"T_sim", "N_sim", "u", "t0"};
-
-using Sp = SimulationProblem;
-using Ov = OptionValue;
-
-// Every scalar option: table, file key, kind, and where it goes.
-constexpr std::array<OptionSpec<Sp>, 2> kSimulationOptions{{
-    {"simulation", "T_sim", Kind::Double, [](Sp& q, const Ov& v) { q.T_sim = v.d; }},
-    {"simulation", "N_sim", Kind::Int, [](Sp& q, const Ov& v) { q.N_sim = v.i; }},
-}};
-constexpr auto kOptions = concat(kSimulationOptions, solver_option_specs<Sp>());
-
-std::vector<std::string_view> keys_of(std::string_view table) {
-  return table == "simulation" ? keys_of_table(kOptions, table, kSimulationKeys)
-                               : keys_of_table(kOptions, table);
-}
-
-/// Rules for [simulation] that validate() (options.hpp) does not cover.
-std::vector<std::string> validate_simulation(const SimulationProblem& q) {
-  std::vector<std::string> e;
-  if (!(std::isfinite(q.T_sim) && q.T_sim > 0))
-    e.push_back(fmt::format("simulation.T_sim = {}: must be > 0", q.T_sim));
-  if (q.N_sim < 1) e.push_back(fmt::format("simulation.N_sim = {}: must be >= 1", q.N_sim));
-  const double t0 = q.has_clock ? q.x0[q.x0.size() - 1] : 0.0;  // the clock starts at t0
-  if (std::string s =
-          core::step_length_error("simulation.T_sim", q.T_sim, "simulation.N_sim", q.N_sim, t0);
-      !s.empty())
-    e.push_back(std::move(s));
-  if (validate(q.options).empty())  // the limits of build(), docs/problem-files.md "Limits"
-    for (std::string& s :
-         discretization::FesdInterval::block_size_errors(q.model, q.options.discretization))
-      e.push_back(std::move(s));
-  return e;
-}
+constexpr registry::Use kKind = registry::Use::Simulation;
 
 std::vector<std::string> validate_all(const SimulationProblem& q) {
-  std::vector<std::string> e = validate_simulation(q);
-  for (std::string& s : validate(q.options)) e.push_back(std::move(s));
+  const double t0 = q.has_clock ? q.x0[q.x0.size() - 1] : 0.0;  // the clock starts at t0
+  std::vector<std::string> e = registry::validate_simulation(q.T_sim, q.N_sim, t0);
+  std::vector<std::string> options = validate(q.options);
+  if (options.empty())  // the limits of build(), docs/problem-files.md "Limits"
+    options = discretization::FesdInterval::block_size_errors(q.model, q.options.discretization);
+  for (std::string& s : options) e.push_back(std::move(s));
   return e;
 }
 
 void read_options(const Reader& r, const toml::table& root, SimulationProblem& problem) {
-  for (std::string_view table_name : {"simulation", "discretization", "homotopy", "ipopt"}) {
-    const toml::node* tn = root.get(table_name);
-    const bool required = table_name == "simulation";
+  const registry::OptionTarget target = target_of(problem);
+  for (registry::Table table : registry::tables(kKind)) {
+    const toml::node* tn = root.get(registry::to_string(table));
     if (tn == nullptr) {
-      if (required)
-        r.fail(toml::source_region{}, table_name,
-               "missing table [simulation] (expected at least T_sim, the length of the time "
-               "interval)");
+      if (table == registry::Table::Simulation) fail_missing_table(r, table);
       continue;
     }
-    const toml::table& t = r.table(*tn, table_name);
-    const std::vector<std::string_view> keys = keys_of(table_name);
-    if (table_name != "ipopt") r.check_keys(t, keys, table_name);
-    for (const OptionSpec<Sp>& o : kOptions) {
-      if (o.table != table_name) continue;
-      if (const toml::node* n = t.get(o.key))
-        o.set(problem, read_option(r, o.table, o.key, o.kind, *n));
-    }
-    if (required && t.get("T_sim") == nullptr)
-      r.fail(t.source(), "simulation",
-             "missing key 'T_sim' (expected the length of the time interval, a number > 0)");
-    if (table_name == "ipopt") read_ipopt_extra(r, t, keys, problem.options.nlp.extra);
+    const toml::table& t = r.table(*tn, registry::to_string(table));
+    check_table_keys(r, t, table, kKind);
+    read_option_table(r, t, table, kKind, target, problem.options.nlp.extra);
+    check_required_key(r, t, table);
   }
   const std::vector<std::string> errors = validate_all(problem);
   if (!errors.empty()) throw_validation_errors(r, root, errors);
@@ -156,27 +117,21 @@ SimulationProblem load_simulation_problem(const std::string& path) {
   return parse_simulation_problem(read_problem_text(path), path);
 }
 
-constexpr std::array<std::string_view, 4> kOverrideTables{"simulation", "discretization",
-                                                          "homotopy", "ipopt"};
-
-void apply_override(SimulationProblem& problem, std::string_view key_in,
-                    std::string_view value_in) {
-  const OverrideArg arg = parse_override_arg(key_in, value_in, kOverrideTables);
-  const std::string_view table = arg.table, key = arg.key;
+void apply_override(SimulationProblem& problem, std::string_view key, std::string_view value_in) {
+  const OverrideArg arg = parse_override_arg(key, value_in, kKind);
   const std::string& value = arg.value;
   const std::string& head = arg.head;
+  const std::string_view input = arg.option != nullptr ? arg.option->key : std::string_view{};
 
   SimulationProblem updated = problem;
-  const OptionSpec<Sp>* spec = find_option(kOptions, table, key);
-
-  if (spec != nullptr) {
-    spec->set(updated, override_value(spec->kind, value, head));
-  } else if ((table.empty() || table == "simulation") && key == "t0") {
+  if (set_scalar_override(arg, target_of(updated))) {
+    // a registry option with a C++ member
+  } else if (input == "t0") {
     const auto d = parse_double(value);
     if (!d) override_error(head, "expected a number");
     if (!std::isfinite(*d)) override_error(head, "must be finite");
     if (updated.has_clock) updated.x0[updated.x0.size() - 1] = *d;
-  } else if ((table.empty() || table == "simulation") && key == "u") {
+  } else if (input == "u") {
     std::vector<double> u;
     std::string_view rest = value;
     while (!rest.empty()) {
@@ -193,22 +148,14 @@ void apply_override(SimulationProblem& problem, std::string_view key_in,
           fmt::format("wrong length (expected {}, one per control, got {})",
                       count(static_cast<std::size_t>(updated.model.n_u()), "number"), u.size()));
     updated.u = Eigen::Map<const Eigen::VectorXd>(u.data(), static_cast<Eigen::Index>(u.size()));
-  } else if (table == "ipopt" && !key.empty()) {
-    set_ipopt_option(updated.options.nlp.extra, key, value);
+  } else if (arg.table == "ipopt" && !arg.key.empty()) {
+    set_ipopt_option(updated.options.nlp.extra, arg.key, value);
   } else {
-    std::vector<std::string_view> valid;
-    for (std::string_view t : kOverrideTables)
-      if (table.empty() || t == table)
-        for (std::string_view k : keys_of(t)) valid.push_back(k);
-    if (table.empty() || table == "discretization") valid.push_back("N_FE");
-    override_error(head, fmt::format("unknown option '{}' {}", key, key_hint(key, valid)));
+    unknown_override(arg, kKind);
   }
 
   const std::vector<std::string> errors = validate_all(updated);
-  if (!errors.empty())
-    throw_override_errors(
-        head, spec != nullptr ? fmt::format("{}.{}", spec->table, spec->key) : std::string{},
-        errors);
+  if (!errors.empty()) throw_override_errors(arg, errors);
   problem = std::move(updated);
 }
 

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 
 namespace fesd::io_detail {
 namespace {
@@ -19,28 +20,6 @@ constexpr std::array<std::string_view, 13> kReservedNames{
 constexpr std::array<std::string_view, 9> kModelKeys{"x", "u", "p",  "c",        "S",
                                                      "F", "g", "x0", "subsystem"};
 constexpr std::array<std::string_view, 4> kSubsystemKeys{"c", "S", "g", "F"};
-
-template <class E, std::size_t K>
-std::string name_list(const std::array<E, K>& values) {
-  std::string s;
-  for (E v : values) s += (s.empty() ? "" : ", ") + std::string(to_string(v));
-  return s;
-}
-constexpr std::array<RkScheme, 5> kSchemes{RkScheme::RadauIIA, RkScheme::GaussLegendre,
-                                           RkScheme::LobattoIIIA, RkScheme::LobattoIIIC,
-                                           RkScheme::ExplicitRK};
-constexpr std::array<CrossComp, 4> kCrossComps{CrossComp::Sparse, CrossComp::StageSum,
-                                               CrossComp::Element, CrossComp::Neighbor};
-constexpr std::array<StepEq, 5> kStepEqs{StepEq::None, StepEq::Eta, StepEq::EtaTanh,
-                                         StepEq::HeuristicMean, StepEq::L2Relaxed};
-constexpr std::array<StageLambdaSign, 3> kStageSigns{
-    StageLambdaSign::All, StageLambdaSign::Boundary, StageLambdaSign::Auto};
-constexpr std::array<MpccMode, 5> kMpccModes{MpccMode::ScholtesIneq, MpccMode::ScholtesEq,
-                                             MpccMode::FischerBurmeister, MpccMode::L1Penalty,
-                                             MpccMode::ElasticIneq};
-// nosnoc's relax_terminal_constraint values that fesd implements.
-constexpr std::array<std::string_view, 2> kTerminalModes{"none", "ell_1"};
-constexpr std::array<std::string_view, 2> kInitModes{"constant", "simulation"};
 
 std::string lower(std::string_view s) {
   std::string r(s);
@@ -521,75 +500,64 @@ BuiltModel build_model(const Reader& r, ModelSpec spec, bool has_clock, double t
 
 // ---- options ----------------------------------------------------------------------------------
 
-std::optional<std::string> parse_enum(Kind kind, std::string_view name, OptionValue& v) {
-  std::string valid;
-  const auto by_name = [&](std::span<const std::string_view> names) {
-    for (std::string_view n : names) valid += (valid.empty() ? "" : ", ") + std::string(n);
-    if (std::find(names.begin(), names.end(), name) == names.end()) return false;
-    v.name = std::string(name);
-    return true;
-  };
-  switch (kind) {
-    case Kind::Scheme:
-      if (parse(name, v.scheme)) return std::nullopt;
-      valid = name_list(kSchemes);
-      break;
-    case Kind::CrossCompMode:
-      if (parse(name, v.cross)) return std::nullopt;
-      valid = name_list(kCrossComps);
-      break;
-    case Kind::StepEqMode:
-      if (parse(name, v.step)) return std::nullopt;
-      valid = name_list(kStepEqs);
-      break;
-    case Kind::StageSignMode:
-      if (parse(name, v.stage_sign)) return std::nullopt;
-      valid = name_list(kStageSigns);
-      break;
-    case Kind::Mpcc:
-      if (parse(name, v.mpcc)) return std::nullopt;
-      valid = name_list(kMpccModes);
-      break;
-    case Kind::TerminalMode:
-      if (by_name(kTerminalModes)) return std::nullopt;
-      break;
-    case Kind::InitMode:
-      if (by_name(kInitModes)) return std::nullopt;
-      break;
-    default:
-      break;
-  }
-  return fmt::format("unknown name (expected one of {}; got \"{}\")", valid, name);
-}
-
-OptionValue read_option(const Reader& r, std::string_view table, std::string_view key, Kind kind,
-                        const toml::node& n) {
-  const std::string path = join(table, key);
-  OptionValue v;
-  switch (kind) {
-    case Kind::Int:
-      v.i = r.integer(n, path);
-      break;
-    case Kind::Double:
-      v.d = r.number(n, path);
-      break;
-    case Kind::Bool:
-      v.b = r.boolean(n, path);
-      break;
-    default: {
+double read_option(const Reader& r, const registry::Option& o, const toml::node& n) {
+  const std::string path = registry::path_of(o);
+  switch (o.kind) {
+    case registry::Kind::Int:
+      return r.integer(n, path);
+    case registry::Kind::Double:
+      return r.number(n, path);
+    case registry::Kind::Bool:
+      return r.boolean(n, path) ? 1 : 0;
+    case registry::Kind::Enum: {
       const std::string name = r.string(n, path);
-      if (auto error = parse_enum(kind, name, v))
-        throw InvalidOption(fmt::format("{}: {}: {}", r.at(n.source()), path, *error));
+      const int i = o.parse_name(name);
+      if (i < 0)
+        throw InvalidOption(
+            fmt::format("{}: {}: {}", r.at(n.source()), path, registry::unknown_name(o, name)));
+      return i;
     }
+    case registry::Kind::Input:
+      break;
   }
-  return v;
+  throw std::logic_error("read_option: " + path + " is read by the loader");
 }
 
-void read_ipopt_extra(const Reader& r, const toml::table& t,
-                      const std::vector<std::string_view>& keys,
-                      std::vector<std::pair<std::string, std::string>>& extra) {
+void check_table_keys(const Reader& r, const toml::table& t, registry::Table table,
+                      registry::Use kind) {
+  if (table == registry::Table::Ipopt) return;  // any other key is IPOPT's
+  r.check_keys(t, registry::keys(table, kind), registry::to_string(table));
+}
+
+void check_required_key(const Reader& r, const toml::table& t, registry::Table table) {
+  const registry::Option* o = registry::required_option(table);
+  if (o == nullptr || t.get(o->key) != nullptr) return;
+  r.fail(t.source(), registry::to_string(table),
+         fmt::format("missing key '{}' (expected {}, {})", o->key, o->doc,
+                     registry::expected_text(*o)));
+}
+
+void fail_missing_table(const Reader& r, registry::Table table) {
+  const registry::Option* o = registry::required_option(table);
+  r.fail(toml::source_region{}, registry::to_string(table),
+         o == nullptr ? fmt::format("missing table [{}]", registry::to_string(table))
+                      : fmt::format("missing table [{}] (expected at least {}, {})",
+                                    registry::to_string(table), o->key, o->doc));
+}
+
+void read_option_table(const Reader& r, const toml::table& t, registry::Table table,
+                       registry::Use kind, const registry::OptionTarget& target,
+                       std::vector<std::pair<std::string, std::string>>& extra,
+                       std::span<const std::string_view> read_elsewhere) {
+  for (const registry::Option& o : registry::all()) {
+    if (o.table != table || o.set == nullptr || !registry::has(o, kind)) continue;
+    if (std::find(read_elsewhere.begin(), read_elsewhere.end(), o.key) != read_elsewhere.end())
+      continue;
+    if (const toml::node* n = t.get(o.key)) o.set(target, read_option(r, o, *n));
+  }
+  if (table != registry::Table::Ipopt) return;
   for (const auto& [k, v] : in_file_order(t)) {
-    if (std::find(keys.begin(), keys.end(), k->str()) != keys.end()) continue;
+    if (registry::find(table, k->str()) != nullptr) continue;
     extra.emplace_back(k->str(), ipopt_value(r, *v, join("ipopt", k->str())));
   }
 }
@@ -603,14 +571,14 @@ std::string ipopt_value(const Reader& r, const toml::node& n, std::string_view p
 }
 
 std::string_view message_key(std::string_view message) {
-  const std::size_t eq = message.find(" = ");
-  return eq == std::string_view::npos ? std::string_view{} : message.substr(0, eq);
+  const std::size_t end = std::min(message.find(" = "), message.find(": "));
+  return end == std::string_view::npos ? std::string_view{} : message.substr(0, end);
 }
 
-void throw_validation_errors(const Reader& r, const toml::table& root,
-                             const std::vector<std::string>& errors) {
+std::string located(const Reader& r, const toml::table& root,
+                    const std::vector<std::string>& messages) {
   std::string msg;
-  for (const std::string& e : errors) {
+  for (const std::string& e : messages) {
     std::string where = r.file();
     const std::string_view key = message_key(e);
     if (!key.empty()) {
@@ -619,7 +587,12 @@ void throw_validation_errors(const Reader& r, const toml::table& root,
     }
     msg += (msg.empty() ? "" : "; ") + fmt::format("{}: {}", where, e);
   }
-  throw InvalidOption(msg);
+  return msg;
+}
+
+void throw_validation_errors(const Reader& r, const toml::table& root,
+                             const std::vector<std::string>& errors) {
+  throw InvalidOption(located(r, root, errors));
 }
 
 // ---- overrides --------------------------------------------------------------------------------
@@ -642,8 +615,7 @@ std::optional<double> parse_double(std::string_view s) {
   return v;
 }
 
-OverrideArg parse_override_arg(std::string_view key, std::string_view value,
-                               std::span<const std::string_view> tables) {
+OverrideArg parse_override_arg(std::string_view key, std::string_view value, registry::Use kind) {
   OverrideArg a;
   while (!key.empty() && key.front() == '-') key.remove_prefix(1);
   a.value = trim(value);
@@ -651,12 +623,28 @@ OverrideArg parse_override_arg(std::string_view key, std::string_view value,
   if (const std::size_t dot = key.find('.'); dot != std::string_view::npos) {
     a.table = key.substr(0, dot);
     key = key.substr(dot + 1);
+    std::vector<std::string_view> tables;
+    for (registry::Table t : registry::tables(kind)) tables.push_back(registry::to_string(t));
     if (std::find(tables.begin(), tables.end(), a.table) == tables.end())
       override_error(a.head,
                      fmt::format("unknown table '{}' {}", a.table, key_hint(a.table, tables)));
   }
-  a.key = key == "N_FE" ? std::string_view("N_finite_elements") : key;
+  a.key = key;
+  for (const registry::Option& o : registry::all()) {
+    if (!registry::has(o, kind) || (!a.table.empty() && registry::to_string(o.table) != a.table))
+      continue;
+    if (o.key == key || (!o.alias.empty() && o.alias == key)) {
+      a.option = &o;
+      a.key = o.key;
+    }
+  }
   return a;
+}
+
+bool set_scalar_override(const OverrideArg& a, const registry::OptionTarget& target) {
+  if (a.option == nullptr || a.option->set == nullptr) return false;
+  a.option->set(target, override_value(*a.option, a.value, a.head));
+  return true;
 }
 
 void set_ipopt_option(std::vector<std::pair<std::string, std::string>>& extra, std::string_view key,
@@ -669,6 +657,21 @@ void set_ipopt_option(std::vector<std::pair<std::string, std::string>>& extra, s
     extra.emplace_back(std::string(key), value);
 }
 
+void unknown_override(const OverrideArg& a, registry::Use kind) {
+  if (a.option != nullptr && !a.option->overridable)
+    override_error(a.head, fmt::format("unknown option '{}' (expressions, bounds and guesses can "
+                                       "only be set in the file)",
+                                       a.key));
+  std::vector<std::string_view> valid;
+  for (const registry::Option& o : registry::all()) {
+    if (!o.overridable || !registry::has(o, kind)) continue;
+    if (!a.table.empty() && registry::to_string(o.table) != a.table) continue;
+    valid.push_back(o.key);
+    if (!o.alias.empty()) valid.push_back(o.alias);
+  }
+  override_error(a.head, fmt::format("unknown option '{}' {}", a.key, key_hint(a.key, valid)));
+}
+
 void override_error(const std::string& head, std::string_view what) {
   throw InvalidOption(fmt::format("{}: {}", head, what));
 }
@@ -679,49 +682,49 @@ std::string trim(std::string_view s) {
   return std::string(s);
 }
 
-OptionValue override_value(Kind kind, const std::string& value, const std::string& head) {
-  OptionValue v;
-  switch (kind) {
-    case Kind::Int: {
+double override_value(const registry::Option& o, const std::string& value,
+                      const std::string& head) {
+  switch (o.kind) {
+    case registry::Kind::Int: {
       const auto i = parse_int(value);
       if (!i) override_error(head, "expected an integer");
-      v.i = *i;
-      break;
+      return *i;
     }
-    case Kind::Double: {
+    case registry::Kind::Double: {
       const auto d = parse_double(value);
       if (!d) override_error(head, "expected a number");
       if (!std::isfinite(*d)) override_error(head, "must be finite");
-      v.d = *d;
-      break;
+      return *d;
     }
-    case Kind::Bool:
-      if (value == "1" || value == "true")
-        v.b = true;
-      else if (value == "0" || value == "false")
-        v.b = false;
-      else
-        override_error(head,
-                       fmt::format("expected a boolean (1, 0, true or false, got \"{}\")", value));
+    case registry::Kind::Bool:
+      if (value == "1" || value == "true") return 1;
+      if (value == "0" || value == "false") return 0;
+      override_error(head,
+                     fmt::format("expected a boolean (1, 0, true or false, got \"{}\")", value));
+    case registry::Kind::Enum: {
+      const int i = o.parse_name(value);
+      if (i < 0) override_error(head, registry::unknown_name(o, value));
+      return i;
+    }
+    case registry::Kind::Input:
       break;
-    default:
-      if (auto error = parse_enum(kind, value, v)) override_error(head, *error);
   }
-  return v;
+  throw std::logic_error("override_value: " + registry::path_of(o) + " is set by the loader");
 }
 
-void throw_override_errors(const std::string& head, std::string_view canonical_key,
-                           const std::vector<std::string>& errors) {
+void throw_override_errors(const OverrideArg& a, const std::vector<std::string>& errors) {
+  const std::string own =
+      a.option != nullptr && a.option->set != nullptr ? registry::path_of(*a.option) : "";
   std::string msg;
   for (const std::string& e : errors) {
     std::string_view text = e;
-    if (!canonical_key.empty() && message_key(text) == canonical_key) {
+    if (!own.empty() && message_key(text) == own) {
       const std::size_t colon = text.find(": ");
       if (colon != std::string_view::npos) text.remove_prefix(colon + 2);
     }
     msg += (msg.empty() ? "" : "; ") + std::string(text);
   }
-  override_error(head, msg);
+  override_error(a.head, msg);
 }
 
 }  // namespace fesd::io_detail

@@ -1,8 +1,8 @@
 // src/io/problem_file_reader.hpp: what simulation files (problem_file.cpp) and optimal control
 // files (ocp_problem_file.cpp) share: the typed TOML reader with "file:line: what" messages, the
-// [model] table, the option table of [discretization], [homotopy] and [ipopt], key hints, and the
-// parsing of command-line override values. Internal to src/io; the format is documented in
-// docs/problem-files.md.
+// [model] table, the option tables read by the option registry (src/core/option_registry.hpp),
+// key hints, and the parsing of command-line override values. Internal to src/io; the format is
+// documented in docs/problem-files.md.
 #pragma once
 #include <algorithm>
 #include <array>
@@ -22,6 +22,7 @@
 #include <toml++/toml.h>
 #include <Eigen/Dense>
 
+#include "core/option_registry.hpp"
 #include "fesd/error.hpp"
 #include "fesd/model.hpp"
 #include "fesd/options.hpp"
@@ -210,148 +211,40 @@ BuiltModel build_model(const Reader& r, ModelSpec spec, bool has_clock, double t
 void check_no_controls(const Reader& r, const expr::Expression& e, const toml::node& n,
                        std::string_view path, const Symbols& sym, std::string_view what);
 
-// ---- scalar options: one table for files and overrides ----------------------------------------
+// ---- options: the keys of the option registry (src/core/option_registry.hpp) -------------------
 
-enum class Kind {
-  Int,
-  Double,
-  Bool,
-  Scheme,
-  CrossCompMode,
-  StepEqMode,
-  StageSignMode,
-  Mpcc,
-  TerminalMode,  // [ocp] relax_terminal_constraint
-  InitMode,      // [ocp] initialization
-};
+/// The value of `o` in a file, converted to the registry's number (Bool 0/1, Enum the index);
+/// throws ProblemFileError (type, NaN) or InvalidOption (unknown enum name).
+double read_option(const Reader& r, const registry::Option& o, const toml::node& n);
 
-/// A value read from a file or a command line, already converted to the option's kind. Enum
-/// names of kinds without a C++ enum here (TerminalMode, InitMode) are kept in `name`.
-struct OptionValue {
-  int i = 0;
-  double d = 0;
-  bool b = false;
-  RkScheme scheme = RkScheme::RadauIIA;
-  CrossComp cross = CrossComp::StageSum;
-  StepEq step = StepEq::HeuristicMean;
-  StageLambdaSign stage_sign = StageLambdaSign::Auto;
-  MpccMode mpcc = MpccMode::ScholtesIneq;
-  std::string name;
-};
+/// Fails on a key of `t` that problems of `kind` do not have in `table` ([ipopt] takes any key).
+void check_table_keys(const Reader& r, const toml::table& t, registry::Table table,
+                      registry::Use kind);
+/// Fails with "missing key 'T' (expected the length of the horizon, a number > 0)" if the table's
+/// required key is absent.
+void check_required_key(const Reader& r, const toml::table& t, registry::Table table);
+/// "missing table [ocp] (expected at least T, the length of the horizon)".
+[[noreturn]] void fail_missing_table(const Reader& r, registry::Table table);
 
-/// One scalar option of a problem type (SimulationProblem or OcpProblem).
-template <class Problem>
-struct OptionSpec {
-  std::string_view table;
-  std::string_view key;
-  Kind kind;
-  void (*set)(Problem&, const OptionValue&);
-};
-
-/// The options of [discretization], [homotopy] and [ipopt], for every problem type whose
-/// `options` has members discretization, homotopy and nlp.
-template <class Problem>
-constexpr std::array<OptionSpec<Problem>, 21> solver_option_specs() {
-  using P = Problem;
-  using V = OptionValue;
-  return {{
-      {"discretization", "rk_scheme", Kind::Scheme,
-       [](P& q, const V& v) { q.options.discretization.rk_scheme = v.scheme; }},
-      {"discretization", "n_s", Kind::Int,
-       [](P& q, const V& v) { q.options.discretization.n_s = v.i; }},
-      {"discretization", "N_finite_elements", Kind::Int,
-       [](P& q, const V& v) { q.options.discretization.N_FE = v.i; }},
-      {"discretization", "use_fesd", Kind::Bool,
-       [](P& q, const V& v) { q.options.discretization.use_fesd = v.b; }},
-      {"discretization", "cross_comp_mode", Kind::CrossCompMode,
-       [](P& q, const V& v) { q.options.discretization.cross_comp = v.cross; }},
-      {"discretization", "step_equilibration", Kind::StepEqMode,
-       [](P& q, const V& v) { q.options.discretization.step_eq = v.step; }},
-      {"discretization", "stage_lambda_sign", Kind::StageSignMode,
-       [](P& q, const V& v) { q.options.discretization.stage_lambda_sign = v.stage_sign; }},
-      {"discretization", "gamma_h", Kind::Double,
-       [](P& q, const V& v) { q.options.discretization.gamma_h = v.d; }},
-      {"discretization", "rho_h", Kind::Double,
-       [](P& q, const V& v) { q.options.discretization.rho_h = v.d; }},
-      {"discretization", "pin_sliding_exits", Kind::Bool,
-       [](P& q, const V& v) { q.options.discretization.pin_sliding_exits = v.b; }},
-      {"homotopy", "mpcc_mode", Kind::Mpcc,
-       [](P& q, const V& v) { q.options.homotopy.mpcc_mode = v.mpcc; }},
-      {"homotopy", "sigma_0", Kind::Double,
-       [](P& q, const V& v) { q.options.homotopy.sigma_0 = v.d; }},
-      {"homotopy", "homotopy_update_slope", Kind::Double,
-       [](P& q, const V& v) { q.options.homotopy.homotopy_update_slope = v.d; }},
-      {"homotopy", "sigma_N", Kind::Double,
-       [](P& q, const V& v) { q.options.homotopy.sigma_N = v.d; }},
-      {"homotopy", "complementarity_tol", Kind::Double,
-       [](P& q, const V& v) { q.options.homotopy.complementarity_tol = v.d; }},
-      {"homotopy", "N_homotopy", Kind::Int,
-       [](P& q, const V& v) { q.options.homotopy.max_homotopy_steps = v.i; }},
-      {"homotopy", "intermediate_tol", Kind::Double,
-       [](P& q, const V& v) { q.options.homotopy.intermediate_tol = v.d; }},
-      {"ipopt", "tol", Kind::Double, [](P& q, const V& v) { q.options.nlp.tol = v.d; }},
-      {"ipopt", "acceptable_tol", Kind::Double,
-       [](P& q, const V& v) { q.options.nlp.acceptable_tol = v.d; }},
-      {"ipopt", "max_iter", Kind::Int, [](P& q, const V& v) { q.options.nlp.max_iter = v.i; }},
-      {"ipopt", "print_level", Kind::Int,
-       [](P& q, const V& v) { q.options.nlp.print_level = v.i; }},
-  }};
-}
-
-/// `first` followed by `second`.
-template <class T, std::size_t A, std::size_t B>
-constexpr std::array<T, A + B> concat(const std::array<T, A>& first,
-                                      const std::array<T, B>& second) {
-  std::array<T, A + B> out{};
-  for (std::size_t i = 0; i < A; ++i) out[i] = first[i];
-  for (std::size_t i = 0; i < B; ++i) out[A + i] = second[i];
-  return out;
-}
-
-/// The keys of `table` among `specs`, in table order, after `extra` (keys handled outside the
-/// table, like [simulation] u).
-template <class Problem, std::size_t K>
-std::vector<std::string_view> keys_of_table(const std::array<OptionSpec<Problem>, K>& specs,
-                                            std::string_view table,
-                                            std::span<const std::string_view> extra = {}) {
-  std::vector<std::string_view> keys(extra.begin(), extra.end());
-  for (const OptionSpec<Problem>& o : specs)
-    if (o.table == table && std::find(keys.begin(), keys.end(), o.key) == keys.end())
-      keys.push_back(o.key);
-  return keys;
-}
-
-/// The option `key` of `table` (of any table if `table` is empty; the last match), or nullptr:
-/// the lookup of a command-line override.
-template <class Problem, std::size_t K>
-const OptionSpec<Problem>* find_option(const std::array<OptionSpec<Problem>, K>& specs,
-                                       std::string_view table, std::string_view key) {
-  const OptionSpec<Problem>* spec = nullptr;
-  for (const OptionSpec<Problem>& o : specs)
-    if (o.key == key && (table.empty() || o.table == table)) spec = &o;
-  return spec;
-}
-
-/// Parses an enum option name; on failure returns "unknown name (expected one of ...)".
-std::optional<std::string> parse_enum(Kind kind, std::string_view name, OptionValue& v);
-
-/// Converts a TOML value to the option's kind; throws ProblemFileError / InvalidOption.
-OptionValue read_option(const Reader& r, std::string_view table, std::string_view key, Kind kind,
-                        const toml::node& n);
+/// Reads every scalar option of `table` that `kind` has into `target`, except the keys in
+/// `read_elsewhere`; in [ipopt], every other key goes to `extra` (IPOPT's own options).
+void read_option_table(const Reader& r, const toml::table& t, registry::Table table,
+                       registry::Use kind, const registry::OptionTarget& target,
+                       std::vector<std::pair<std::string, std::string>>& extra,
+                       std::span<const std::string_view> read_elsewhere = {});
 
 /// An [ipopt] value as IPOPT's option string (numbers shortest exact, booleans yes/no).
 std::string ipopt_value(const Reader& r, const toml::node& n, std::string_view path);
-/// Appends every key of the [ipopt] table `t` that is not one of fesd's own `keys` to `extra`, in
-/// file order, as (name, IPOPT value string).
-void read_ipopt_extra(const Reader& r, const toml::table& t,
-                      const std::vector<std::string_view>& keys,
-                      std::vector<std::pair<std::string, std::string>>& extra);
 
-/// The "table.key" a validate() message starts with ("discretization.n_s = 0: ...").
+/// The key path a validation message starts with: "discretization.n_s" of
+/// "discretization.n_s = 0: ...", "model.x0[1]" of "model.x0[1]: 2 is outside ...".
 std::string_view message_key(std::string_view message);
 
-/// Joins validation messages into one InvalidOption, each prefixed with the file and the line of
-/// the key it names (or just the file).
+/// The messages joined by "; ", each prefixed with the file and the line of the key it names (or
+/// just the file).
+std::string located(const Reader& r, const toml::table& root,
+                    const std::vector<std::string>& messages);
+/// throw InvalidOption(located(...)).
 [[noreturn]] void throw_validation_errors(const Reader& r, const toml::table& root,
                                           const std::vector<std::string>& errors);
 
@@ -361,24 +254,29 @@ std::optional<int> parse_int(std::string_view s);
 std::optional<double> parse_double(std::string_view s);
 std::string trim(std::string_view s);
 [[noreturn]] void override_error(const std::string& head, std::string_view what);
-/// Parses an override value of `kind` ("3", "1e-9", "true", "gauss_legendre"); throws
-/// InvalidOption "<head>: <what>". Numbers must be finite.
-OptionValue override_value(Kind kind, const std::string& value, const std::string& head);
+/// Parses an override value of `o` ("3", "1e-9", "true", "gauss_legendre") into the registry's
+/// number; throws InvalidOption "<head>: <what>". Numbers must be finite.
+double override_value(const registry::Option& o, const std::string& value, const std::string& head);
 /// An override as given: leading dashes dropped, an optional "table." prefix split off and
-/// checked against `tables`, "N_FE" read as "N_finite_elements", the value trimmed. `head` is
+/// checked against the tables of `kind`, the value trimmed, and the registry option it names (by
+/// key or alias, within the table if one is given; nullptr if none). `head` is
 /// "--<key as given> = <value>", the start of every message about it.
 struct OverrideArg {
   std::string_view table, key;
   std::string value, head;
+  const registry::Option* option = nullptr;
 };
-OverrideArg parse_override_arg(std::string_view key, std::string_view value,
-                               std::span<const std::string_view> tables);
+OverrideArg parse_override_arg(std::string_view key, std::string_view value, registry::Use kind);
+/// Sets a scalar option, or returns false for a key that is not one (Input keys, IPOPT's own).
+bool set_scalar_override(const OverrideArg& a, const registry::OptionTarget& target);
 /// Sets the IPOPT option `key` to `value` in `extra`, replacing an earlier value.
 void set_ipopt_option(std::vector<std::pair<std::string, std::string>>& extra, std::string_view key,
                       const std::string& value);
-/// Joins the validation messages of an override; the key's own "table.key = v: " prefix is
-/// dropped (the head already names it).
-[[noreturn]] void throw_override_errors(const std::string& head, std::string_view canonical_key,
+/// "unknown option 'n_S' (did you mean 'n_s'?)"; for a key that only a file can set, says so.
+[[noreturn]] void unknown_override(const OverrideArg& a, registry::Use kind);
+/// Joins the validation messages of an override; the overridden key's own "table.key = v: "
+/// prefix is dropped (the head already names it).
+[[noreturn]] void throw_override_errors(const OverrideArg& a,
                                         const std::vector<std::string>& errors);
 
 }  // namespace fesd::io_detail

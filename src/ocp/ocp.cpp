@@ -23,6 +23,7 @@
 #include "nlp/nlp_solver.hpp"
 #include "nlp/sum_block.hpp"
 #include "ocp/ocp_checks.hpp"
+#include "ocp/ocp_input.hpp"
 
 namespace fesd {
 namespace {
@@ -115,27 +116,6 @@ struct TerminalConstraintEq {
 
 // ---- input checks ------------------------------------------------------------------------------
 
-void check_vector(const Eigen::VectorXd& v, Eigen::Index n, const char* name, bool allow_inf) {
-  if (v.size() != n)
-    throw InvalidModel(fmt::format("ocp.{} has {} entries, expected {}", name, v.size(), n));
-  for (Eigen::Index i = 0; i < v.size(); ++i)
-    if (std::isnan(v[i]) || (!allow_inf && !std::isfinite(v[i])))
-      throw InvalidModel(fmt::format("ocp.{}[{}] = {}: must be {}", name, i, v[i],
-                                     allow_inf ? "a number" : "finite"));
-}
-
-/// Bounds: empty = unbounded; else n entries, no NaN, lb <= ub.
-void check_bounds(const Eigen::VectorXd& lb, const Eigen::VectorXd& ub, Eigen::Index n,
-                  const char* lb_name, const char* ub_name) {
-  if (lb.size() > 0) check_vector(lb, n, lb_name, true);
-  if (ub.size() > 0) check_vector(ub, n, ub_name, true);
-  if (lb.size() > 0 && ub.size() > 0)
-    for (Eigen::Index i = 0; i < n; ++i)
-      if (lb[i] > ub[i])
-        throw InvalidModel(fmt::format("ocp.{}[{}] = {} > ocp.{}[{}] = {}: empty bounds", lb_name,
-                                       i, lb[i], ub_name, i, ub[i]));
-}
-
 double lower(const Eigen::VectorXd& lb, Eigen::Index i) {
   return lb.size() == 0 ? -kInf : std::max(lb[i], -kInf);
 }
@@ -149,52 +129,7 @@ std::vector<int> intervals_N_FE(const Ocp& ocp, const OcpOptions& o) {
 }
 
 void check_input(const Ocp& ocp, const OcpOptions& o) {
-  if (auto e = validate(o); !e.empty()) {
-    std::string all;
-    for (const auto& s : e) all += (all.empty() ? "" : "; ") + s;
-    throw InvalidOption(all);
-  }
-  const Pss& m = ocp.model;
-  if (m.n_x() < 1) throw InvalidModel("ocp.model: empty (n_x = 0)");
-  if (!std::isfinite(ocp.T) || ocp.T <= 0)
-    throw InvalidOption(fmt::format("ocp.T = {}: must be finite and > 0", ocp.T));
-  if (ocp.N_stages < 1)
-    throw InvalidOption(fmt::format("ocp.N_stages = {}: must be >= 1", ocp.N_stages));
-  if (std::string e = ocp_detail::step_length_error(ocp); !e.empty()) throw InvalidOption(e);
-  if (!ocp.N_FE.empty() && static_cast<int>(ocp.N_FE.size()) != ocp.N_stages)
-    throw InvalidOption(fmt::format("ocp.N_FE has {} entries, expected N_stages = {} (or none)",
-                                    ocp.N_FE.size(), ocp.N_stages));
-  const int min_fe = o.discretization.use_fesd ? 2 : 1;
-  for (int n : intervals_N_FE(ocp, o))
-    if (n < min_fe || n > 1000)
-      throw InvalidOption(fmt::format(
-          "N_finite_elements = {}: must be in [{}, 1000]{}", n, min_fe,
-          o.discretization.use_fesd ? " (FESD needs two elements to move a switch)" : ""));
-  check_vector(ocp.x0, m.n_x(), "x0", false);
-  if ((ocp.lbx0.size() > 0) != (ocp.ubx0.size() > 0))
-    throw InvalidModel("ocp.lbx0 and ocp.ubx0: give both (x0 free) or neither (x0 fixed)");
-  check_bounds(ocp.lbx0, ocp.ubx0, m.n_x(), "lbx0", "ubx0");
-  check_bounds(ocp.lbx, ocp.ubx, m.n_x(), "lbx", "ubx");
-  check_bounds(ocp.lbu, ocp.ubu, m.n_u(), "lbu", "ubu");
-  if (ocp.u_guess.size() > 0) check_vector(ocp.u_guess, m.n_u(), "u_guess", false);
-  if (ocp.p.size() > 0) check_vector(ocp.p, m.n_p(), "p", false);
-  if (ocp.n_g_path < 0 || ocp.n_g_terminal < 0)
-    throw InvalidModel("ocp.n_g_path and ocp.n_g_terminal must be >= 0");
-  if ((ocp.n_g_path > 0 || ocp.n_g_terminal > 0) && !ocp.functions)
-    throw InvalidModel("ocp: constraints declared (n_g_path / n_g_terminal > 0) but no functions");
-  check_bounds(ocp.lbg_path, ocp.ubg_path, ocp.n_g_path, "lbg_path", "ubg_path");
-  check_bounds(ocp.lbg_terminal, ocp.ubg_terminal, ocp.n_g_terminal, "lbg_terminal",
-               "ubg_terminal");
-  if (!(ocp.rho_terminal > 0) || !std::isfinite(ocp.rho_terminal))
-    throw InvalidOption(
-        fmt::format("ocp.rho_terminal = {}: must be finite and > 0", ocp.rho_terminal));
-  if (ocp.lbx0.size() > 0)
-    for (Eigen::Index i = 0; i < m.n_x(); ++i)
-      if (ocp.x0[i] < ocp.lbx0[i] || ocp.x0[i] > ocp.ubx0[i])
-        throw InvalidModel(fmt::format("ocp.x0[{}] = {} is outside [lbx0, ubx0] = [{}, {}]", i,
-                                       ocp.x0[i], ocp.lbx0[i], ocp.ubx0[i]));
-  if (auto e = ocp_detail::block_size_errors(ocp, o); !e.empty())
-    throw InvalidModel(fmt::format("{}", fmt::join(e, "; ")));
+  ocp_detail::require_valid_input(ocp, o);  // src/ocp/ocp_input.cpp, shared with problem files
 }
 
 // ---- the NLP -----------------------------------------------------------------------------------

@@ -164,6 +164,36 @@ TEST(Cli, OverridesAreApplied) {
   EXPECT_TRUE(contains(alone.err, "N_finite_elements")) << alone.err;
 }
 
+// docs/problem-files.md, "Overrides": --TABLE.KEY VALUE, --ipopt.NAME VALUE, --ipopt.NAME=VALUE,
+// and every [simulation] key (u, t0 too).
+TEST(Cli, QualifiedOverrideForms) {
+  ASSERT_TRUE(fs::exists(kOscillator)) << kOscillator << " is missing";
+  const CliRun r =
+      run_cli({"check", kOscillator, "--discretization.n_s", "3", "--homotopy.sigma_0=0.5",
+               "--ipopt.tol", "1e-10", "--ipopt.mu_strategy", "monotone", "--ipopt.bound_push=1e-9",
+               "--discretization.N_FE", "4", "--t0", "0", "--u", ""});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(contains(r.out, "n_s = 3, N_FE = 4")) << r.out;
+  EXPECT_TRUE(contains(r.out, "sigma_0 = 0.5")) << r.out;
+  EXPECT_TRUE(contains(r.out, "tol = 1e-10")) << r.out;
+  EXPECT_TRUE(contains(r.out, "mu_strategy = monotone, bound_push = 1e-9")) << r.out;
+  const CliRun bad = run_cli({"check", kOscillator, "--homotopy.n_s", "3"});
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_TRUE(contains(bad.err, "--homotopy.n_s")) << bad.err;
+  EXPECT_EQ(bad.err_lines(), 1) << bad.err;
+}
+
+TEST(Cli, HelpGroupsOverridesByTable) {
+  const CliRun r = run_cli({"simulate", "--help"});
+  EXPECT_EQ(r.code, 0) << r.err;
+  for (const char* group : {"Overrides [simulation]", "Overrides [discretization]",
+                            "Overrides [homotopy]", "Overrides [ipopt]"})
+    EXPECT_TRUE(contains(r.out, group)) << group << "\n" << r.out;
+  EXPECT_TRUE(contains(r.out, "--n_s INT")) << r.out;
+  EXPECT_TRUE(contains(r.out, "1..9")) << r.out;
+  EXPECT_TRUE(contains(r.out, "--ipopt.NAME VALUE")) << r.out;
+}
+
 TEST(Cli, BadPlotExtensionExits2BeforeSolving) {
   ASSERT_TRUE(fs::exists(kOscillator)) << kOscillator << " is missing";
   TempDir dir;

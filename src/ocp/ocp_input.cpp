@@ -1,0 +1,157 @@
+// The input rules of an optimal control problem (ocp_input.hpp). The ranges of the scalar options
+// come from the option registry (src/core/option_registry.cpp); this file adds the rules about the
+// problem's data and the per-interval numbers of finite elements.
+#include "ocp/ocp_input.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <string_view>
+
+#include <fmt/format.h>
+
+#include "core/option_registry.hpp"
+#include "fesd/error.hpp"
+#include "ocp/ocp_checks.hpp"
+
+namespace fesd::ocp_detail {
+namespace {
+
+std::string numbers(Eigen::Index n) {
+  return fmt::format("{} number{}", n, n == 1 ? "" : "s");
+}
+
+/// Length n (what: "one per state"); entries finite, or (allow_inf) anything but NaN.
+bool check_vector(std::vector<std::string>& e, const Eigen::VectorXd& v, Eigen::Index n,
+                  std::string_view path, std::string_view what, bool allow_inf) {
+  if (v.size() != n) {
+    e.push_back(fmt::format("{}: wrong length (expected {}, {}, got {})", path, numbers(n), what,
+                            v.size()));
+    return false;
+  }
+  bool ok = true;
+  for (Eigen::Index i = 0; i < v.size(); ++i)
+    if (std::isnan(v[i]) || (!allow_inf && !std::isfinite(v[i]))) {
+      e.push_back(
+          fmt::format("{}[{}] = {}: must be {}", path, i, v[i],
+                      allow_inf ? "a number (inf and -inf are allowed, nan is not)" : "finite"));
+      ok = false;
+    }
+  return ok;
+}
+
+/// Bounds [lb, ub] of the [ocp] keys lb_key/ub_key: empty = unbounded; else n entries, no NaN,
+/// lb <= ub. True if both are usable entry by entry.
+bool check_bounds(std::vector<std::string>& e, const Eigen::VectorXd& lb, const Eigen::VectorXd& ub,
+                  Eigen::Index n, std::string_view lb_key, std::string_view ub_key,
+                  std::string_view what) {
+  const bool lb_ok =
+      lb.size() == 0 || check_vector(e, lb, n, fmt::format("ocp.{}", lb_key), what, true);
+  const bool ub_ok =
+      ub.size() == 0 || check_vector(e, ub, n, fmt::format("ocp.{}", ub_key), what, true);
+  if (!lb_ok || !ub_ok) return false;
+  if (lb.size() == 0 || ub.size() == 0) return true;
+  for (Eigen::Index i = 0; i < n; ++i)
+    if (lb[i] > ub[i])
+      e.push_back(fmt::format("ocp.{}[{}] = {} > ocp.{}[{}] = {}: empty bounds (expected {} <= {})",
+                              lb_key, i, lb[i], ub_key, i, ub[i], lb_key, ub_key));
+  return true;
+}
+
+/// v[i] within [lb[i], ub[i]] (bounds checked before; empty = unbounded).
+void check_within(std::vector<std::string>& e, const Eigen::VectorXd& v, const Eigen::VectorXd& lb,
+                  const Eigen::VectorXd& ub, std::string_view path, std::string_view bounds,
+                  std::string_view why) {
+  for (Eigen::Index i = 0; i < v.size(); ++i) {
+    const double l = lb.size() > 0 ? lb[i] : -INFINITY, u = ub.size() > 0 ? ub[i] : INFINITY;
+    if (v[i] < l || v[i] > u)
+      e.push_back(fmt::format("{}[{}]: {} is outside [{}] = [{}, {}] ({})", path, i, v[i], bounds,
+                              l, u, why));
+  }
+}
+
+std::string list_of_ints(const std::vector<int>& v) {
+  std::string s;
+  for (int i : v) s += fmt::format("{}{}", s.empty() ? "" : ", ", i);
+  return "[" + s + "]";
+}
+
+/// Ocp::N_FE: one number of finite elements per control interval, each within the range and
+/// rule of [discretization] N_finite_elements.
+void check_N_FE_list(std::vector<std::string>& e, const Ocp& ocp, const OcpOptions& o) {
+  if (ocp.N_FE.empty()) return;
+  const registry::Option& option =
+      *registry::find(registry::Table::Discretization, "N_finite_elements");
+  const std::string path = registry::path_of(option);
+  if (static_cast<int>(ocp.N_FE.size()) != ocp.N_stages)
+    e.push_back(fmt::format(
+        "{} = {}: wrong length (expected {} {}, one per control interval (N_stages = {}), or one "
+        "integer for all intervals)",
+        path, list_of_ints(ocp.N_FE), ocp.N_stages, ocp.N_stages == 1 ? "entry" : "entries",
+        ocp.N_stages));
+  const registry::OptionTarget target = registry::target_of(o);
+  for (std::size_t k = 0; k < ocp.N_FE.size(); ++k) {
+    std::string m = registry::check(option, target, ocp.N_FE[k], fmt::format("{}[{}]", path, k));
+    if (!m.empty()) e.push_back(std::move(m));
+  }
+}
+
+void check_data(std::vector<std::string>& e, const Ocp& ocp) {
+  const Pss& m = ocp.model;
+  if (m.n_x() < 1) {
+    e.push_back("ocp.model: empty (n_x = 0)");
+    return;
+  }
+  const Eigen::Index n_x = m.n_x(), n_u = m.n_u();
+  const bool x0_ok = check_vector(e, ocp.x0, n_x, "model.x0", "one per state", false);
+  if ((ocp.lbx0.size() > 0) != (ocp.ubx0.size() > 0))
+    e.push_back("ocp.lbx0, ocp.ubx0: give both (x0 free) or neither (x0 fixed)");
+  const bool x0_bounds_ok =
+      check_bounds(e, ocp.lbx0, ocp.ubx0, n_x, "lbx0", "ubx0", "one per state");
+  check_bounds(e, ocp.lbx, ocp.ubx, n_x, "lbx", "ubx", "one per state");
+  const bool u_bounds_ok = check_bounds(e, ocp.lbu, ocp.ubu, n_u, "lbu", "ubu", "one per control");
+  if (ocp.u_guess.size() > 0 &&
+      check_vector(e, ocp.u_guess, n_u, "ocp.u_guess", "one per control", false) && u_bounds_ok)
+    check_within(e, ocp.u_guess, ocp.lbu, ocp.ubu, "ocp.u_guess", "lbu, ubu",
+                 "expected a guess within the control bounds");
+  if (x0_ok && x0_bounds_ok && ocp.lbx0.size() > 0)
+    check_within(e, ocp.x0, ocp.lbx0, ocp.ubx0, "model.x0", "lbx0, ubx0",
+                 "with lbx0/ubx0, model.x0 is the guess of the free initial state and must "
+                 "satisfy its bounds");
+  check_vector(e, ocp.p.size() > 0 ? ocp.p : m.p_default, m.n_p(), "model.p", "one per parameter",
+               false);
+  if (ocp.n_g_path < 0) e.push_back(fmt::format("ocp.n_g_path = {}: must be >= 0", ocp.n_g_path));
+  if (ocp.n_g_terminal < 0)
+    e.push_back(fmt::format("ocp.n_g_terminal = {}: must be >= 0", ocp.n_g_terminal));
+  if ((ocp.n_g_path > 0 || ocp.n_g_terminal > 0) && !ocp.functions)
+    e.push_back("ocp.functions: none, but constraints are declared (n_g_path / n_g_terminal > 0)");
+  check_bounds(e, ocp.lbg_path, ocp.ubg_path, std::max(ocp.n_g_path, 0), "lbg_path", "ubg_path",
+               "one per path constraint");
+  check_bounds(e, ocp.lbg_terminal, ocp.ubg_terminal, std::max(ocp.n_g_terminal, 0), "lbg_terminal",
+               "ubg_terminal", "one per terminal constraint");
+}
+
+}  // namespace
+
+OcpInputErrors check_input(const Ocp& ocp, const OcpOptions& options) {
+  OcpInputErrors e;
+  registry::OptionTarget target = registry::target_of(options);
+  target.ocp = const_cast<Ocp*>(&ocp);  // read only
+  e.options = registry::check(registry::Table::Ocp, target);
+  check_N_FE_list(e.options, ocp, options);
+  for (std::string& s : validate(options)) e.options.push_back(std::move(s));
+  if (e.options.empty())  // the smallest control interval, docs/problem-files.md "Limits"
+    if (std::string s = step_length_error(ocp); !s.empty()) e.options.push_back(std::move(s));
+  check_data(e.data, ocp);
+  if (e.options.empty() && e.data.empty())  // the limits of the NLP's blocks
+    e.data = block_size_errors(ocp, options);
+  return e;
+}
+
+void require_valid_input(const Ocp& ocp, const OcpOptions& options) {
+  const OcpInputErrors e = check_input(ocp, options);
+  if (!e.options.empty()) throw InvalidOption(registry::join(e.options));
+  if (!e.data.empty()) throw InvalidModel(registry::join(e.data));
+}
+
+}  // namespace fesd::ocp_detail
