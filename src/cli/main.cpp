@@ -143,9 +143,14 @@ struct Overrides {
   std::vector<std::string> values;
   std::vector<CLI::Option*> options;
   std::vector<std::string> ipopt;
+  /// Arguments CLI11 did not recognize (the command allows extras): an unknown --KEY VALUE goes
+  /// to fesd::apply_override, whose message names the nearest option ("unknown option 'n_S'
+  /// (did you mean 'n_s'?)").
+  std::vector<std::string> extras;
 
   /// Adds the options of `scope` (Both: every option, for `check`, which reads either kind).
   void add_to(CLI::App& app, Scope scope) {
+    app.allow_extras();
     for (const fesd::registry::Option& o : fesd::registry::all())
       if (o.overridable && fesd::registry::has(o, scope)) keys.push_back(&o);
     values.resize(keys.size());
@@ -188,6 +193,20 @@ struct Overrides {
     for (std::size_t i = 0; i < keys.size(); ++i) {
       if (options[i] != nullptr && options[i]->count() > 0) {
         out.emplace_back(keys[i]->key, values[i]);
+      }
+    }
+    for (std::size_t i = 0; i < extras.size(); ++i) {
+      const std::string& item = extras[i];
+      if (item.size() < 3 || item.compare(0, 2, "--") != 0)
+        throw UsageError(fmt::format("unexpected argument '{}'", item));
+      const std::size_t eq = item.find('=');
+      if (eq != std::string::npos) {
+        out.emplace_back(item.substr(2, eq - 2), item.substr(eq + 1));
+      } else if (i + 1 < extras.size() && extras[i + 1].compare(0, 2, "--") != 0) {
+        out.emplace_back(item.substr(2), extras[i + 1]);
+        ++i;
+      } else {
+        throw UsageError(fmt::format("option '{}' needs a value ({} VALUE)", item, item));
       }
     }
     for (const std::string& item : ipopt) {
@@ -637,6 +656,9 @@ int run(int argc, char** argv) {
     return kExitBadInput;
   }
 
+  sim.overrides.extras = simulate->remaining();
+  ocp.overrides.extras = solve->remaining();
+  check_overrides.extras = check_cmd->remaining();
   if (simulate->parsed()) return run_simulate(sim, *simulate);
   if (solve->parsed()) return run_solve(ocp, *solve);
   if (check_cmd->parsed()) return run_check(check_file, check_overrides);

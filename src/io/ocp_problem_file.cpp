@@ -151,14 +151,7 @@ OcpProblem parse_ocp_problem(std::string_view toml_text, std::string_view source
            "missing table [ocp] (expected at least T, the length of the horizon)");
 
   OcpProblem problem;
-  problem.source = std::string(source_name);
-  problem.name = std::filesystem::path(std::string(source_name)).stem().string();
-  if (const toml::node* n = root.get("name")) {
-    problem.name = r.string(*n, "name");
-    if (problem.name.empty()) r.fail(n->source(), "name", "empty (expected a non-empty name)");
-  }
-  if (const toml::node* n = root.get("description"))
-    problem.description = r.string(*n, "description");
+  read_name(r, root, source_name, problem);
 
   ModelSpec spec = read_model_spec(r, root);
   const Symbols sym = spec.sym;

@@ -79,14 +79,7 @@ SimulationProblem parse_simulation_problem(std::string_view toml_text,
   r.check_keys(root, kTopKeys, "");
 
   SimulationProblem problem;
-  problem.source = std::string(source_name);
-  problem.name = std::filesystem::path(std::string(source_name)).stem().string();
-  if (const toml::node* n = root.get("name")) {
-    problem.name = r.string(*n, "name");
-    if (problem.name.empty()) r.fail(n->source(), "name", "empty (expected a non-empty name)");
-  }
-  if (const toml::node* n = root.get("description"))
-    problem.description = r.string(*n, "description");
+  read_name(r, root, source_name, problem);
 
   // t0 is needed by the model (clock initial value); read it first.
   double t0 = 0.0;

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <filesystem>
 #include <limits>
 #include <optional>
 #include <set>
@@ -165,6 +166,21 @@ class Reader {
  private:
   std::string file_;
 };
+
+/// The top-level keys every problem file has: `source` (the file), `name` (default: the file's
+/// stem) and `description`.
+template <class Problem>  // SimulationProblem or OcpProblem
+void read_name(const Reader& r, const toml::table& root, std::string_view source_name,
+               Problem& problem) {
+  problem.source = std::string(source_name);
+  problem.name = std::filesystem::path(std::string(source_name)).stem().string();
+  if (const toml::node* n = root.get("name")) {
+    problem.name = r.string(*n, "name");
+    if (problem.name.empty()) r.fail(n->source(), "name", "empty (expected a non-empty name)");
+  }
+  if (const toml::node* n = root.get("description"))
+    problem.description = r.string(*n, "description");
+}
 
 // ---- [model] ----------------------------------------------------------------------------------
 

@@ -109,6 +109,27 @@ TEST(Cli, UnknownOptionExits2) {
   EXPECT_EQ(r.err_lines(), 1) << r.err;
 }
 
+// A misspelt option gets the nearest valid one, as docs/problem-files.md promises; both the
+// "--KEY VALUE" and the "--KEY=VALUE" form, for every command.
+TEST(Cli, MisspeltOptionSuggestsTheNearest) {
+  for (const char* cmd : {"simulate", "check"}) {
+    for (const auto& args : {std::vector<std::string>{"--n_S", "3"}, {"--n_S=3"}}) {
+      std::vector<std::string> argv{cmd, kOscillator};
+      argv.insert(argv.end(), args.begin(), args.end());
+      const CliRun r = run_cli(argv);
+      EXPECT_EQ(r.code, 2) << cmd;
+      EXPECT_TRUE(contains(r.err, "unknown option 'n_S' (did you mean 'n_s'?)")) << r.err;
+      EXPECT_EQ(r.err_lines(), 1) << r.err;
+    }
+  }
+  const CliRun no_value = run_cli({"simulate", kOscillator, "--n_S"});
+  EXPECT_EQ(no_value.code, 2);
+  EXPECT_TRUE(contains(no_value.err, "'--n_S' needs a value")) << no_value.err;
+  const CliRun stray = run_cli({"simulate", kOscillator, "stray"});
+  EXPECT_EQ(stray.code, 2);
+  EXPECT_TRUE(contains(stray.err, "unexpected argument 'stray'")) << stray.err;
+}
+
 TEST(Cli, MissingFileExits2WithThePath) {
   const std::string path = "/nonexistent/dir/problem.toml";
   for (const char* command : {"simulate", "check"}) {
