@@ -408,7 +408,12 @@ class Parser {
     fail("cannot parse " + quoted() + ": " + what);
   }
   /// The text in quotes, on one line, shortened (shown()).
-  std::string quoted() const { return "'" + shown(text_) + "'"; }
+  std::string quoted() const {
+    std::string q(1, '\'');  // (not "'" + ... + "'": GCC 12 warns -Wrestrict, a false positive)
+    q += shown(text_);
+    q += '\'';
+    return q;
+  }
   std::string span(std::size_t begin, std::size_t end) const {
     return std::string(text_.substr(begin, end - begin));
   }
