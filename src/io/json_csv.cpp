@@ -79,7 +79,8 @@ json homotopy_row(const HomotopyRow& r) {
               {"nlp_iterations", r.nlp_iterations},
               {"nlp_status", r.nlp_status},
               {"cpu_s", number(r.cpu_s)},
-              {"linear_solver", r.linear_solver}};
+              {"linear_solver", r.linear_solver},
+              {"pinned_exits", r.pinned_exits}};
 }
 
 json homotopy(const std::vector<std::vector<HomotopyRow>>& steps) {
