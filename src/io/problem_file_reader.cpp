@@ -81,7 +81,7 @@ void check_names(const Reader& r,
       r.fail(node->source(), p,
              fmt::format("invalid {} name (expected an identifier [A-Za-z_][A-Za-z0-9_]*, got "
                          "\"{}\")",
-                         kind, name));
+                         kind, expr::shorten(name)));
     if (std::find(kReservedNames.begin(), kReservedNames.end(), name) != kReservedNames.end())
       r.fail(node->source(), p,
              fmt::format("'{}' is reserved by the expression language (functions sin cos tan exp "
@@ -93,7 +93,8 @@ void check_names(const Reader& r,
              fmt::format("'t' is the time; only a state may be named t (got a {} named t)", kind));
     if (!seen.insert(name).second)
       r.fail(node->source(), p,
-             fmt::format("duplicate name '{}' (names must be unique across x, u and p)", name));
+             fmt::format("duplicate name '{}' (names must be unique across x, u and p)",
+                         expr::shorten(name)));
   }
 }
 
@@ -559,7 +560,7 @@ std::optional<std::string> parse_enum(Kind kind, std::string_view name, OptionVa
     default:
       break;
   }
-  return fmt::format("unknown name (expected one of {}; got \"{}\")", valid, name);
+  return fmt::format("unknown name (expected one of {}; got \"{}\")", valid, expr::shorten(name));
 }
 
 OptionValue read_option(const Reader& r, std::string_view table, std::string_view key, Kind kind,
