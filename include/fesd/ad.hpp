@@ -213,10 +213,25 @@ inline Jet<N> pow(const Jet<N>& a, double p) {
   if (p == 0.0) return Jet<N>(1.0);
   return scaled(std::pow(a.v, p), p * std::pow(a.v, p - 1.0), a);
 }
+/// a^b with the value of std::pow (so 0^0 = 1 and (-2)^3 = -8 as for double, where
+/// exp(b log a) would give NaN) and d(a^b) = b a^(b - 1) da + a^b log(a) db.
 template <int N>
 inline Jet<N> pow(const Jet<N>& a, const Jet<N>& b) {
   if (b.n == 0) return pow(a, b.v);
-  return exp(b * log(a));
+  const double r = std::pow(a.v, b.v);
+  const double ca = b.v * std::pow(a.v, b.v - 1.0), cb = r * std::log(a.v);
+  if (std::isfinite(ca) && std::isfinite(cb)) return lincomb(r, ca, a, cb, b);
+  // log(a) of a <= 0 (or 0^(b - 1)) is not finite: an input that only a (or only b) depends on
+  // still gets its derivative ((-2)^y at y = 3: d/dx = 12), not 0 * inf = NaN.
+  assume_length<N>(a.n);
+  assume_length<N>(b.n);
+  Jet<N> out(r);
+  out.n = std::max(a.n, b.n);
+  for (int i = 0; i < out.n; ++i) {
+    const double da = a.d(i), db = b.d(i);
+    out.g[i] = (da != 0.0 ? ca * da : 0.0) + (db != 0.0 ? cb * db : 0.0);
+  }
+  return out;
 }
 template <int N>
 inline Jet<N> pow(double a, const Jet<N>& b) {
@@ -519,7 +534,10 @@ inline bool has_derivative(const Dual<T>& x) {
 template <class T>
 inline Dual<T> pow(const Dual<T>& a, const Dual<T>& b) {
   if (!has_derivative(b)) return pow(a, value_of(b));
-  return exp(b * log(a));
+  using std::log;
+  using std::pow;
+  const T r = pow(a.v, b.v);  // as pow(Jet, Jet): the value of std::pow
+  return {r, (b.v * pow(a.v, b.v - 1.0)) * a.d + (r * log(a.v)) * b.d};
 }
 
 #define FESD_AD_COMPARISONS(TYPE, TEMPLATE_HEAD)                                         \

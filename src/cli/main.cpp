@@ -66,7 +66,7 @@ constexpr int kExitBadInput = 2;
 constexpr int kExitIo = 3;
 constexpr int kExitInternal = 4;
 constexpr const char* kExitHelp =
-    "Exit codes: 0 solved (check: valid), 1 not converged (outputs still written), 2 bad input, "
+    "Exit codes: 0 solved (check: valid), 1 not converged (outputs still written), 2 bad input,\n"
     "3 I/O failure (output files, standard output), 4 internal error (a bug, or out of memory).";
 
 /// Error messages are printed as one line: line breaks become "; ".

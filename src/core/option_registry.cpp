@@ -461,7 +461,19 @@ std::string help_text(const Option& o) {
 }
 
 std::string unknown_name(const Option& o, std::string_view got) {
-  return fmt::format("unknown name (expected one of {}; got \"{}\")", list(o.names, ", "), got);
+  // At most 60 characters of what was given (a 9 KB value must not make a 9 KB message).
+  constexpr std::size_t kShown = 60;
+  std::string shown;
+  std::size_t chars = 0;
+  for (char ch : got) {
+    const bool continuation = (static_cast<unsigned char>(ch) & 0xC0) == 0x80;
+    if (!continuation && chars++ == kShown) {
+      shown += "...";
+      break;
+    }
+    shown += ch;
+  }
+  return fmt::format("unknown name (expected one of {}; got \"{}\")", list(o.names, ", "), shown);
 }
 
 std::string check(const Option& o, const OptionTarget& t, double value, std::string_view path) {

@@ -60,7 +60,7 @@ void check_names(const Reader& r,
       r.fail(node->source(), p,
              fmt::format("invalid {} name (expected an identifier [A-Za-z_][A-Za-z0-9_]*, got "
                          "\"{}\")",
-                         kind, name));
+                         kind, expr::shorten(name)));
     if (std::find(kReservedNames.begin(), kReservedNames.end(), name) != kReservedNames.end())
       r.fail(node->source(), p,
              fmt::format("'{}' is reserved by the expression language (functions sin cos tan exp "
@@ -72,7 +72,8 @@ void check_names(const Reader& r,
              fmt::format("'t' is the time; only a state may be named t (got a {} named t)", kind));
     if (!seen.insert(name).second)
       r.fail(node->source(), p,
-             fmt::format("duplicate name '{}' (names must be unique across x, u and p)", name));
+             fmt::format("duplicate name '{}' (names must be unique across x, u and p)",
+                         expr::shorten(name)));
   }
 }
 

@@ -79,7 +79,8 @@ class Reader {
       if (std::find(valid.begin(), valid.end(), k.str()) != valid.end()) continue;
       const std::string where = path.empty() ? "at the top level" : fmt::format("in [{}]", path);
       fail(k.source(), "",
-           fmt::format("unknown key '{}' {} {}", k.str(), where, key_hint(k.str(), valid)));
+           fmt::format("unknown key '{}' {} {}", expr::shorten(k.str()), where,
+                       key_hint(k.str(), valid)));
     }
   }
 

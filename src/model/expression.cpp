@@ -409,7 +409,7 @@ class Parser {
   }
   /// The text in quotes, on one line, shortened (shown()).
   std::string quoted() const {
-    std::string q(1, '\'');  // (not "'" + ... + "'": GCC 12 warns -Wrestrict, a false positive)
+    std::string q = "'";  // (not "'" + std::string&&: GCC 12 -Wrestrict false positive)
     q += shown(text_);
     q += '\'';
     return q;
@@ -644,10 +644,14 @@ class Parser {
     candidates.push_back("pi");
     std::string message = "unknown symbol '" + name_shown + "' in " + quoted() + " (";
     if (const std::string_view s = closest(name, candidates); !s.empty())
-      message += "did you mean '" + std::string(s) + "'?; ";
+      message += "did you mean '" + shown(s) + "'?; ";
     message += "known symbols: ";
     if (symbols_.empty()) message += "none";
-    for (std::size_t i = 0; i < symbols_.size(); ++i) message += (i > 0 ? ", " : "") + symbols_[i];
+    constexpr std::size_t kListed = 20;  // the message stays one readable line
+    for (std::size_t i = 0; i < symbols_.size() && i < kListed; ++i)
+      message += (i > 0 ? ", " : "") + shown(symbols_[i]);
+    if (symbols_.size() > kListed)
+      message += ", ... (" + std::to_string(symbols_.size() - kListed) + " more)";
     fail(message + ")");
   }
 

@@ -475,18 +475,44 @@ TEST(Expression, ConstantToThePowerZeroIsOne) {
   EXPECT_EQ(eval("x^0 * y^(3-3)", {"x", "y"}, {0.0, -2.0}), 1.0);
 }
 
+TEST(Expression, VariablePowerHasTheDoubleValueForEveryScalarType) {
+  // Found by fuzz/fuzz_expression.cpp: x^y with both variable took exp(y log x) in AD, NaN at
+  // x = 0, y = 0 (std::pow gives 1) and for x < 0 with integer y.
+  const Expression e = parse("x^y", {"x", "y"});
+  for (const auto& [x, y] : {std::pair{0.0, 0.0}, {0.0, -0.0}, {-2.0, 3.0}, {0.5, 1.5}}) {
+    const double v = std::pow(x, y);
+    const double xy[] = {x, y};
+    EXPECT_EQ(e.evaluate(xy), v);
+    const Jet<8> jin[] = {Jet<8>::variable(x, 0, 2), Jet<8>::variable(y, 1, 2)};
+    const Jet<8> j = e.evaluate(jin);
+    EXPECT_EQ(j.v, v) << x << "^" << y;
+    const Hyper<8> hin[] = {Hyper<8>(Jet<8>::variable(x, 0, 2), Jet<8>(1.0)),
+                            Hyper<8>(Jet<8>::variable(y, 1, 2), Jet<8>(0.0))};
+    EXPECT_EQ(e.evaluate(hin).v.v, v) << x << "^" << y;
+    if (x > 0) {  // d/dx = y x^(y-1), d/dy = x^y log x
+      EXPECT_DOUBLE_EQ(j.g[0], y * std::pow(x, y - 1));
+      EXPECT_DOUBLE_EQ(j.g[1], v * std::log(x));
+    }
+  }
+  const double at[] = {-2.0, 3.0};
+  const Jet<8> jin[] = {Jet<8>::variable(at[0], 0, 2), Jet<8>::variable(at[1], 1, 2)};
+  EXPECT_EQ(e.evaluate(jin).g[0], 12.0);  // d/dx (-2)^3 = 3 * 4
+}
+
 TEST(Expression, LongTextIsShortenedInMessages) {
   // Issue 12, 6(d): a 2 MB expression nested too deeply was repeated whole in the message.
   const std::string deep = std::string(1000000, '(') + "x1" + std::string(1000000, ')');
   const std::string message = error_of(deep);
   EXPECT_NE(message.find("nested too deeply"), std::string::npos) << message.substr(0, 200);
   EXPECT_LT(message.size(), 200U) << message.substr(0, 400);
-  EXPECT_NE(message.find("'" + std::string(60, '(') + "...'"), std::string::npos) << message;
+  EXPECT_NE(message.find(std::string("'") + std::string(60, '(') + "...'"), std::string::npos)
+      << message;
   // Every part of the text a message quotes is shortened: symbols, functions, numbers.
   const std::string long_name(100000, 'q');
   for (const std::string& text :
-       {long_name + " + x1", long_name + "(x1)", "x1 + 1" + std::string(100000, '0') + "e999",
-        "x1 + " + std::string(5000, '1') + "/0", "x1 " + long_name}) {
+       {long_name + " + x1", long_name + "(x1)",
+        std::string("x1 + 1") + std::string(100000, '0') + "e999",
+        std::string("x1 + ") + std::string(5000, '1') + "/0", "x1 " + long_name}) {
     const std::string m = error_of(text);
     EXPECT_LT(m.size(), 400U) << m.substr(0, 400);
     EXPECT_EQ(m.find('\n'), std::string::npos);
@@ -494,10 +520,19 @@ TEST(Expression, LongTextIsShortenedInMessages) {
   // Up to 60 characters are quoted whole, UTF-8 characters are not cut.
   EXPECT_ERROR("x1 +* 2", "cannot parse 'x1 +* 2'");
   const std::string sixty = std::string(58, 'x') + " $";
-  EXPECT_NE(error_of(sixty).find("'" + sixty + "'"), std::string::npos) << error_of(sixty);
+  EXPECT_NE(error_of(sixty).find(std::string("'") + sixty + "'"), std::string::npos)
+      << error_of(sixty);
   const std::string utf8 = std::string(59, 'x') + "\u00b7\u00b7 $";
-  EXPECT_NE(error_of(utf8).find("'" + std::string(59, 'x') + "\u00b7...'"), std::string::npos)
+  EXPECT_NE(error_of(utf8).find(std::string("'") + std::string(59, 'x') + "\u00b7...'"),
+            std::string::npos)
       << error_of(utf8);
+  // Long symbol names and long symbol lists too.
+  std::vector<std::string> many;
+  for (int i = 0; i < 1000; ++i) many.push_back(std::string(500, 'a') + std::to_string(i));
+  const std::string listed = error_of("b", many);
+  EXPECT_LT(listed.size(), 2000U) << listed.substr(0, 300);
+  EXPECT_NE(listed.find("... (980 more))"), std::string::npos)
+      << listed.substr(listed.size() - 100);
   EXPECT_EQ(shorten(std::string(61, 'a')), std::string(60, 'a') + "...");
   EXPECT_EQ(shorten("a\nb"), "a b");
 }

@@ -3,11 +3,13 @@
 // and patterns (bit for bit: the NLPs must not change), and no input limit beyond ad::kMaxInputs.
 #include <memory>
 #include <random>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "fesd/error.hpp"
 #include "nlp/block.hpp"
 #include "nlp/sum_block.hpp"
 
@@ -127,6 +129,14 @@ TEST(SumBlocks, HaveNoInputLimit) {
   const fesd::nlp::BlockPattern p = products->pattern(v.data());
   EXPECT_EQ(p.jac_rows.at(0).size(), static_cast<std::size_t>(f.num_inputs()));
   EXPECT_EQ(p.hess.size(), static_cast<std::size_t>(k + 1));  // k distinct pairs + the square
+}
+
+TEST(AutoDiffBlock, MoreInputsThanCapacityIsAnInternalError) {
+  // The input checks (FesdInterval::block_size_errors) reject such sizes before building, so
+  // reaching the AD limit is a bug in fesd (exit code 4), not bad input.
+  static_assert(!std::is_base_of_v<fesd::Error, fesd::InternalError>);
+  EXPECT_THROW(autodiff(fesd::nlp::Sum{fesd::ad::kMaxInputs + 1}), fesd::InternalError);
+  EXPECT_NO_THROW(autodiff(fesd::nlp::Sum{fesd::ad::kMaxInputs}));
 }
 
 }  // namespace
