@@ -96,10 +96,7 @@ inline std::string problem_file_finding(std::string_view text) {
     try {
       detail::build_step(q);
     } catch (const InvalidOption& e) {
-      // fischer_burmeister with element/neighbor cross complementarity is rejected when the NLP
-      // is built, not when the file is read (a known gap, docs/fuzzing.md).
-      if (std::string_view(e.what()).find("fischer_burmeister") == std::string_view::npos)
-        return std::string("loads, but the step NLP does not build: ") + e.what();
+      return std::string("loads, but the step NLP does not build: ") + e.what();
     }
   } catch (const Error& e) {
     finding = detail::too_long(e);

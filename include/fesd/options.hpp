@@ -146,6 +146,10 @@ struct IntegratorOptions {
 std::vector<std::string> validate(const DiscretizationOptions& o);
 std::vector<std::string> validate(const HomotopyOptions& o);
 std::vector<std::string> validate(const NlpOptions& o);
+/// The three tables together, with the rules across them (fischer_burmeister needs
+/// cross_comp_mode sparse or stage_sum).
+std::vector<std::string> validate(const DiscretizationOptions& d, const HomotopyOptions& h,
+                                  const NlpOptions& n);
 std::vector<std::string> validate(const IntegratorOptions& o);
 /// Throws fesd::InvalidOption with all messages of validate() if any.
 void check(const IntegratorOptions& o);

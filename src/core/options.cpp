@@ -5,6 +5,8 @@
 #include <cctype>
 #include <string>
 
+#include <fmt/format.h>
+
 #include "core/option_registry.hpp"
 #include "fesd/error.hpp"
 #include "fesd/ocp.hpp"
@@ -140,11 +142,25 @@ std::vector<std::string> validate(const NlpOptions& o) {
   return registry::check(registry::Table::Ipopt, registry::target_of(o));
 }
 
-std::vector<std::string> validate(const IntegratorOptions& o) {
-  std::vector<std::string> e = validate(o.discretization);
-  for (auto& s : validate(o.homotopy)) e.push_back(std::move(s));
-  for (auto& s : validate(o.nlp)) e.push_back(std::move(s));
+std::vector<std::string> validate(const DiscretizationOptions& d, const HomotopyOptions& h,
+                                  const NlpOptions& n) {
+  std::vector<std::string> e = validate(d);
+  for (auto& s : validate(h)) e.push_back(std::move(s));
+  for (auto& s : validate(n)) e.push_back(std::move(s));
+  // A rule across tables: the smoothed C-function needs groups with a common factor (one
+  // complementarity pair per group), which the element and neighbor forms (29) do not have.
+  if (h.mpcc_mode == MpccMode::FischerBurmeister && d.use_fesd &&
+      (d.cross_comp == CrossComp::Element || d.cross_comp == CrossComp::Neighbor))
+    e.push_back(fmt::format(
+        "homotopy.mpcc_mode = fischer_burmeister: needs discretization.cross_comp_mode sparse or "
+        "stage_sum (got {}: its groups sum products of different theta and lambda, not one pair "
+        "that a C-function can smooth)",
+        to_string(d.cross_comp)));
   return e;
+}
+
+std::vector<std::string> validate(const IntegratorOptions& o) {
+  return validate(o.discretization, o.homotopy, o.nlp);
 }
 
 void check(const IntegratorOptions& o) {

@@ -469,10 +469,7 @@ std::string step_length_error(const Ocp& ocp) {
 }  // namespace ocp_detail
 
 std::vector<std::string> validate(const OcpOptions& o) {
-  std::vector<std::string> e = validate(o.discretization);
-  for (auto& s : validate(o.homotopy)) e.push_back(std::move(s));
-  for (auto& s : validate(o.nlp)) e.push_back(std::move(s));
-  return e;
+  return validate(o.discretization, o.homotopy, o.nlp);
 }
 
 OcpResult solve(const Ocp& ocp, const OcpOptions& options) {

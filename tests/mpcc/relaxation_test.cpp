@@ -300,6 +300,15 @@ TEST(FischerBurmeister, IntegratorRejectsElementForm) {
   Eigen::VectorXd x0(1);
   x0 << -1.0;
   EXPECT_THROW(fesd::integrate(crossing_model(), x0, 1.0, 2, o), fesd::InvalidOption);
+  // ... and so does the option validation (fesd check), naming both keys.
+  const std::vector<std::string> e = fesd::validate(o);
+  ASSERT_EQ(e.size(), 1u);
+  EXPECT_NE(e[0].find("homotopy.mpcc_mode = fischer_burmeister"), std::string::npos) << e[0];
+  EXPECT_NE(e[0].find("discretization.cross_comp_mode sparse or stage_sum (got element"),
+            std::string::npos)
+      << e[0];
+  o.discretization.cross_comp = fesd::CrossComp::StageSum;
+  EXPECT_TRUE(fesd::validate(o).empty());
 }
 
 // Free-sign lambdas (stage_lambda_sign = boundary, explicit RK: 3 elements x 2 stages x 2 regions)
