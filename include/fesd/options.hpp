@@ -30,10 +30,12 @@ bool parse(std::string_view name, CrossComp& out);
 
 /// Step equilibration (Sect. 3.2.3): how the spurious degrees of freedom of h_n are removed.
 enum class StepEq {
-  None,           ///< h_n free within its bounds
-  Eta,            ///< (31): (h_n - h_{n-1}) eta_n = 0
-  EtaTanh,        ///< (31) with tanh(eta_n), better scaled
-  HeuristicMean,  ///< penalty rho_h * sum_n (h_n - T / N_FE)^2 in the objective (nosnoc's default)
+  None,     ///< h_n free within its bounds
+  Eta,      ///< (31): (h_n - h_{n-1}) eta_n = 0
+  EtaTanh,  ///< (31) with tanh(eta_n), better scaled
+  /// penalty rho_h * sum_n (h_n - T / N_FE)^2 in the objective (nosnoc's HEURISTIC_MEAN; the
+  /// default of nosnoc_py is HEURISTIC_DELTA, rho_h * sum_n (h_n - h_{n-1})^2, not in fesd yet)
+  HeuristicMean,
   /// penalty rho_h * sum_n tanh(eta_n) ((h_n - h_{n-1}) / h_0)^2: (31) as a smooth penalty. Zero
   /// on every piecewise-uniform grid whose steps change only at switches, so unlike
   /// heuristic_mean it does not bias a solution; unlike eta it has no corner where the grid
