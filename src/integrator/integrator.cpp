@@ -416,6 +416,8 @@ class Integrator {
     if (failed_ != nullptr)
       append_step(res_, model_, *failed_->iv, tab_, failed_->mpcc.solution(), t_);
     res_.status = last_.status;
+    // The failed step's residual counts too (the report must not say 0 after a failure).
+    res_.summary.max_comp_residual = std::max(res_.summary.max_comp_residual, last_.comp_residual);
     res_.message = fmt::format(
         "step {} of {} (t = {:.6g}): {} (last IPOPT status {}, complementarity residual {:.2e})",
         step + 1, N_sim_, t_, describe(last_.status), last_.last_nlp_status, last_.comp_residual);

@@ -274,6 +274,9 @@ TEST(Cli, NumericalFailureExits1AndStillWrites) {
   ASSERT_TRUE(fs::exists(json));
   const nlohmann::json j = nlohmann::json::parse(read_file(json));
   EXPECT_NE(j["status"], "success");
+  // The failed step's residual is reported (was 0: only solved steps counted).
+  ASSERT_TRUE(j["stats"]["max_comp_residual"].is_number());
+  EXPECT_GT(j["stats"]["max_comp_residual"].get<double>(), 0.0);
 }
 
 // REAL SOLVE (one short step), run in an empty working directory.
