@@ -131,7 +131,7 @@ void check_input(const Pss& model, const Eigen::VectorXd& x0, double T_sim, int 
     throw InvalidOption(registry::join(e));
   if (auto e = discretization::FesdInterval::block_size_errors(model, options.discretization);
       !e.empty())
-    throw InvalidModel(fmt::format("{}", fmt::join(e, "; ")));
+    throw InvalidModel(registry::join(e));
   if (u.size() != model.n_u())
     throw InvalidModel(fmt::format("u has {} entries, expected n_u = {}", u.size(), model.n_u()));
   if (p.size() != model.n_p())
@@ -389,11 +389,7 @@ class Integrator {
   }
 
   void account(const mpcc::HomotopyResult& h, std::vector<HomotopyRow>& rows) {
-    res_.summary.homotopy_steps += static_cast<int>(h.rows.size());
-    res_.summary.nlp_iterations += h.nlp_iterations;
-    res_.summary.derivative_s += h.eval_s;
-    res_.summary.solver_s += h.solver_s;
-    rows.insert(rows.end(), h.rows.begin(), h.rows.end());
+    mpcc::add_to_summary(h, res_.summary, rows);
   }
 
   /// Appends the solved step to the result; its end state and last stage start the next step.

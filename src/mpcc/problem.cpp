@@ -64,6 +64,14 @@ double comp_residual(const double* x, const std::vector<CompPair>& pairs) {
   return r;
 }
 
+void add_to_summary(const HomotopyResult& h, Summary& summary, std::vector<HomotopyRow>& rows) {
+  rows.insert(rows.end(), h.rows.begin(), h.rows.end());
+  summary.homotopy_steps += static_cast<int>(h.rows.size());
+  summary.nlp_iterations += h.nlp_iterations;
+  summary.derivative_s += h.eval_s;
+  summary.solver_s += h.solver_s;
+}
+
 // ---- description ------------------------------------------------------------------------------
 
 nlp::BlockNlp& Problem::nlp() {

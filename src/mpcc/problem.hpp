@@ -43,6 +43,10 @@ struct HomotopyResult {
   std::string last_nlp_status;
 };
 
+/// Adds a homotopy's (or re-solve's) rows to `rows` and its work (NLPs, iterations, evaluation
+/// and solver time) to `summary`: the bookkeeping of every front end.
+void add_to_summary(const HomotopyResult& h, Summary& summary, std::vector<HomotopyRow>& rows);
+
 /// Iteration limit of solve_again: a warm-started re-solve with pinned exits converges in 10-30
 /// IPOPT iterations when it converges at all; failing ones ran into the configured 500.
 inline constexpr int kSolveAgainMaxIter = 100;

@@ -114,7 +114,8 @@ struct TerminalConstraintEq {
   }
 };
 
-// ---- input checks ------------------------------------------------------------------------------
+// ---- bounds (empty: unbounded)-------------------------------------------------------------------
+// --------------------------------------------------------------------
 
 double lower(const Eigen::VectorXd& lb, Eigen::Index i) {
   return lb.size() == 0 ? -kInf : std::max(lb[i], -kInf);
@@ -126,10 +127,6 @@ double upper(const Eigen::VectorXd& ub, Eigen::Index i) {
 std::vector<int> intervals_N_FE(const Ocp& ocp, const OcpOptions& o) {
   if (ocp.N_FE.empty()) return std::vector<int>(ocp.N_stages, o.discretization.N_FE);
   return ocp.N_FE;
-}
-
-void check_input(const Ocp& ocp, const OcpOptions& o) {
-  ocp_detail::require_valid_input(ocp, o);  // src/ocp/ocp_input.cpp, shared with problem files
 }
 
 // ---- the NLP -----------------------------------------------------------------------------------
@@ -474,11 +471,8 @@ std::vector<std::string> validate(const OcpOptions& o) {
 
 OcpResult solve(const Ocp& ocp, const OcpOptions& options) {
   const auto t_start = Clock::now();
-  check_input(ocp, options);
-  const Eigen::VectorXd p = ocp.p.size() > 0 ? ocp.p : ocp.model.p_default;
-  if (p.size() != ocp.model.n_p())
-    throw InvalidModel(
-        fmt::format("ocp.p has {} entries, expected n_p = {}", p.size(), ocp.model.n_p()));
+  ocp_detail::require_valid_input(ocp, options);  // src/ocp/ocp_input.cpp, shared with files
+  const Eigen::VectorXd p = ocp.p.size() > 0 ? ocp.p : ocp.model.p_default;  // n_p checked
 
   std::unique_ptr<OcpNlp> b = build(ocp, options, p);
   mpcc::Problem& mp = b->mpcc;
@@ -495,11 +489,7 @@ OcpResult solve(const Ocp& ocp, const OcpOptions& options) {
 
   const std::unique_ptr<nlp::NlpSolver> solver = nlp::make_solver(options.nlp);
   auto account = [&](const mpcc::HomotopyResult& h) {
-    res.homotopy.insert(res.homotopy.end(), h.rows.begin(), h.rows.end());
-    res.summary.homotopy_steps += static_cast<int>(h.rows.size());
-    res.summary.nlp_iterations += h.nlp_iterations;
-    res.summary.derivative_s += h.eval_s;
-    res.summary.solver_s += h.solver_s;
+    mpcc::add_to_summary(h, res.summary, res.homotopy);
   };
   mpcc::HomotopyResult hr = mp.solve_homotopy(*solver, options.homotopy, options.on_homotopy_row);
   account(hr);
