@@ -203,11 +203,8 @@ OcpProblem parse_ocp_problem(std::string_view toml_text, std::string_view source
   layout.n_p = ocp.model.n_p();
   ocp.n_g_path = static_cast<int>(e.g_path.size());
   ocp.n_g_terminal = static_cast<int>(e.g_terminal.size());
-  try {
-    ocp.functions = std::make_shared<const ExpressionOcpFunctions>(layout, std::move(e));
-  } catch (const InvalidModel& err) {
-    throw InvalidModel(fmt::format("{}: {}", r.at(t.source()), err.what()));
-  }
+  // Its layout checks are invariants of this reader (fesd::InternalError), not input errors.
+  ocp.functions = std::make_shared<const ExpressionOcpFunctions>(layout, std::move(e));
 
   // Bounds and guesses; their rules (lb <= ub, guesses within bounds) are checked with the
   // options (read_options). The clock (if any) is unbounded and starts at 0.
