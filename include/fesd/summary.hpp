@@ -26,8 +26,10 @@ struct HomotopyRow {
   double cpu_s = 0;
   /// KKT solver IPOPT used: "dense" (LAPACK LDL', small NLPs) or "mumps".
   std::string linear_solver;
-  /// > 0: not a homotopy step but the last NLP solved once more with this many sliding exits
-  /// pinned (DiscretizationOptions::pin_sliding_exits).
+  /// Not a homotopy step but the last NLP solved once more with the active set of every element
+  /// fixed (HomotopyOptions::fix_active_set, or sliding exits to pin).
+  bool active_set_fixed = false;
+  /// > 0: that re-solve pinned this many sliding exits (DiscretizationOptions::pin_sliding_exits).
   int pinned_exits = 0;
 };
 
@@ -37,6 +39,10 @@ struct SwitchEvent {
   int element = 0;          ///< global index of the element that ends at t
   std::vector<int> before;  ///< active regions (0-based region indices) before t
   std::vector<int> after;   ///< active regions after t
+  /// false: a sliding exit whose pinned re-solve failed. t is then the element boundary the
+  /// relaxed solution put the exit on, which may be off by up to an element length (the FESD
+  /// equations leave an exit O(h) free, docs/formulation.md); Summary::warnings names it.
+  bool located = true;
 };
 
 /// Work and time of a whole run (an integration or an OCP solve).
@@ -66,12 +72,22 @@ struct Summary {
   /// has more than N_sim * N_FE elements.
   int split_steps = 0;
 
+  // ---- the re-solve with the active set fixed (HomotopyOptions::fix_active_set) ----
+  /// Successful re-solves of a step's (the OCP's) last NLP with every element's active set fixed:
+  /// complementarity then holds exactly, not to complementarity_tol.
+  int active_set_solves = 0;
+  /// Such re-solves without exits to pin that failed: the homotopy's solution stays.
+  int active_set_failures = 0;
   // ---- pinned sliding exits (DiscretizationOptions::pin_sliding_exits) ----
-  /// Exits at an element boundary where the leaving region's theta was still > 1e-6, each moved
-  /// to where it reaches 0 by solving the last NLP once more (a row with pinned_exits > 0).
+  /// Exits that left a sliding mode early (at an element boundary where the leaving region's
+  /// theta was still > 0), each moved to where it reaches 0 in the re-solve.
   int pinned_exits = 0;
-  /// Re-solves with pinned exits that failed; those solutions stay unpinned.
+  /// Re-solves with pinned exits that failed; those solutions stay unpinned and their exits are
+  /// marked SwitchEvent::located = false.
   int pin_failures = 0;
+  /// What the user should know about the result although it succeeded (settings that cannot
+  /// reach complementarity_tol, switch times that could not be located), one sentence each.
+  std::vector<std::string> warnings = {};
 };
 
 /// Progress of the integrator: one call per integration step (all its attempts included).
@@ -100,5 +116,7 @@ std::string format_step_progress(const StepProgress& p);
 /// The work and time lines every full report ends with: NLPs, iterations, pinned exits, wall
 /// time split into derivatives, IPOPT + MUMPS and setup. `per_step` > 0 adds per-step figures.
 std::string format_work(const Summary& s, double per_step = 0);
+/// "  warning: ...\n" per Summary::warnings entry (empty if none).
+std::string format_warnings(const Summary& s);
 
 }  // namespace fesd

@@ -260,6 +260,10 @@ std::vector<Option> build() {
   o.push_back(scalar<&T::homotopy, &H::intermediate_tol>(
       kHom, "intermediate_tol", kBoth, "IPOPT tol of the NLPs with sigma > 10 complementarity_tol",
       "", Range{.min = 0, .note = "(0: ipopt.tol everywhere)"}));
+  o.push_back(scalar<&T::homotopy, &H::fix_active_set>(
+      kHom, "fix_active_set", Use::Simulation,
+      "solve each step's last NLP once more with its active set fixed (exact complementarity)",
+      ""));
 
   // [ipopt]: IPOPT's own options that fesd sets; any other key goes to IPOPT by name.
   o.push_back(scalar<&T::nlp, &N::tol>(kIpopt, "tol", kBoth, "IPOPT tol", "", kPositive));

@@ -11,8 +11,9 @@
 namespace fesd {
 
 std::string format_switch(const SwitchEvent& s) {
-  return fmt::format("    t_s = {:.12g}   active regions {{{}}} -> {{{}}}\n", s.t,
-                     fmt::join(s.before, ","), fmt::join(s.after, ","));
+  return fmt::format("    t_s = {:.12g}   active regions {{{}}} -> {{{}}}{}\n", s.t,
+                     fmt::join(s.before, ","), fmt::join(s.after, ","),
+                     s.located ? "" : "   (not located: may be off by up to one element)");
 }
 
 std::string homotopy_table_header() {
@@ -24,9 +25,11 @@ std::string format_homotopy_row(const HomotopyRow& r) {
   std::string row = fmt::format(
       "{:>4} {:>9.1e} {:>10.2e} {:>14.7e} {:>9.1e} {:>5}  {:<26} {:>8.3f}", r.k, r.sigma,
       r.comp_residual, r.objective, r.inf_pr, r.nlp_iterations, r.nlp_status, r.cpu_s);
-  if (r.pinned_exits > 0)
-    row += fmt::format("  (the last NLP again, {} sliding exit{} pinned)", r.pinned_exits,
-                       r.pinned_exits == 1 ? "" : "s");
+  if (r.active_set_fixed)
+    row += r.pinned_exits > 0
+               ? fmt::format("  (the last NLP again, active set fixed, {} sliding exit{} pinned)",
+                             r.pinned_exits, r.pinned_exits == 1 ? "" : "s")
+               : std::string("  (the last NLP again, active set fixed)");
   return row + "\n";
 }
 
@@ -34,6 +37,12 @@ std::string format_step_progress(const StepProgress& p) {
   return fmt::format("  step {:>4}/{}  t = {:<10.6g}  NLPs {:>2}  iter {:>4}  comp {:.1e}  {}\n",
                      p.step, p.N_sim, p.t, p.nlps, p.nlp_iterations, p.comp_residual,
                      to_string(p.status));
+}
+
+std::string format_warnings(const Summary& s) {
+  std::string out;
+  for (const std::string& w : s.warnings) out += fmt::format("  warning: {}\n", w);
+  return out;
 }
 
 std::string format_work(const Summary& s, double per_step) {
@@ -54,6 +63,10 @@ std::string format_work(const Summary& s, double per_step) {
                        s.refined_steps);
   if (s.split_steps > 0)
     out += fmt::format("  split steps          {}  (retried as two half steps)\n", s.split_steps);
+  if (s.active_set_solves > 0 || s.active_set_failures > 0)
+    out += fmt::format("  fixed active set     {} re-solve{}  ({} failed: relaxed solution kept)\n",
+                       s.active_set_solves, s.active_set_solves == 1 ? "" : "s",
+                       s.active_set_failures + s.pin_failures);
   if (s.pinned_exits > 0 || s.pin_failures > 0)
     out += fmt::format("  pinned sliding exits {}  ({} re-solve{} failed, unpinned)\n",
                        s.pinned_exits, s.pin_failures, s.pin_failures == 1 ? "" : "s");

@@ -512,12 +512,21 @@ void FesdInterval::set_guess(std::vector<double>& w, const Eigen::VectorXd& x0,
   update_lifted_guess(w);
 }
 
+bool FesdInterval::stage_active(const double* w, int n, int m, int r) const {
+  const double th = w[theta(n, m, r)];
+  return th > std::max(std::abs(w[lambda(n, m, r)]), kActiveThetaTol);
+}
+
 std::vector<int> FesdInterval::active_set(const double* w, int n) const {
   std::vector<int> active;
   for (int r = 0; r < model_.n_theta(); ++r) {
-    double th = 0;
-    for (int s = 0; s < n_s_; ++s) th = std::max(th, w[theta(n, s, r)]);
-    if (th > kActiveThetaTol) active.push_back(r);
+    double th = 0, th_max = 0, la = 0;
+    for (int s = 0; s < n_s_; ++s) {
+      th += w[theta(n, s, r)];
+      th_max = std::max(th_max, w[theta(n, s, r)]);
+      la += std::abs(w[lambda(n, s, r)]);
+    }
+    if (th > la && th_max > kActiveThetaTol) active.push_back(r);
   }
   return active;
 }
@@ -554,9 +563,7 @@ std::vector<FesdInterval::ExitPin> FesdInterval::exits_to_pin(const double* w,
       return false;
     };
     for (int r = first; r < end; ++r) {
-      if (!slides(active[last], r) || w[theta(last, n_s_ - 1, r)] > kExitThetaTol ||
-          w[lambda(last, n_s_ - 1, r)] <= kExitLambdaTol)
-        continue;
+      if (!slides(active[last], r) || stage_active(w, last, n_s_ - 1, r)) continue;
       if (control_jump_at_end)
         pins.push_back({last, r, false});
       else if (last >= 1 && slides(active[last - 1], r))
@@ -566,12 +573,36 @@ std::vector<FesdInterval::ExitPin> FesdInterval::exits_to_pin(const double* w,
   return pins;
 }
 
-std::vector<nlp::Bound> FesdInterval::pin_exit(const ExitPin& pin) const {
+std::vector<nlp::Bound> FesdInterval::pin_bounds(const double* w,
+                                                 const std::vector<ExitPin>& pins) const {
   if (!can_pin_exits())
-    throw InternalError("FesdInterval::pin_exit needs FESD with a stiffly accurate scheme");
+    throw InternalError("FesdInterval::pin_bounds needs FESD with a stiffly accurate scheme");
+  // The active sets to fix: the solution's, with each pinned exit's region kept in its element
+  // and (theta_zero) removed from the next.
+  std::vector<std::vector<int>> active(N_FE_);
+  for (int n = 0; n < N_FE_; ++n) active[n] = active_set(w, n);
+  for (const ExitPin& pin : pins) {
+    if (!has(active[pin.n], pin.r)) {
+      active[pin.n].push_back(pin.r);
+      std::sort(active[pin.n].begin(), active[pin.n].end());
+    }
+    if (pin.theta_zero && pin.n + 1 < N_FE_) std::erase(active[pin.n + 1], pin.r);
+  }
   std::vector<nlp::Bound> bounds;
-  for (int s = 0; s < n_s_; ++s) bounds.push_back({lambda(pin.n, s, pin.r), 0.0, 0.0});
-  if (pin.theta_zero) bounds.push_back({theta(pin.n, n_s_ - 1, pin.r), 0.0, 0.0});  // theta >= 0
+  for (int n = 0; n < N_FE_; ++n)
+    for (int r = 0; r < model_.n_theta(); ++r) {
+      // theta = 0 off the active set; lambda = 0 on it at every point of the element: its start
+      // (the end of the element before: a crossing or sliding entry there puts the state on the
+      // boundary of r), its stages and its end boundary.
+      if (!has(active[n], r)) {
+        for (int s = 0; s < n_s_; ++s) bounds.push_back({theta(n, s, r), 0.0, 0.0});
+        continue;
+      }
+      // (a free-sign stage lambda too: theta lambda = 0 with theta > 0)
+      for (const std::vector<int>& point : points_[n]) bounds.push_back({point[r], 0.0, 0.0});
+    }
+  for (const ExitPin& pin : pins)
+    if (pin.theta_zero) bounds.push_back({theta(pin.n, n_s_ - 1, pin.r), 0.0, 0.0});
   return bounds;
 }
 

@@ -103,11 +103,19 @@ class FesdInterval {
   const std::vector<CompGroup>& groups() const { return groups_; }
   /// Step-equilibration rows (31), for eta reporting; -1 if none.
   const std::vector<int>& step_eq_rows() const { return step_eq_rows_; }
-  /// Active regions of element n at the NLP point w: theta_{n,m,r} > kActiveThetaTol at some
-  /// stage m. theta is a convex weight in [0, 1]; inactive regions have theta ~ sigma / lambda
-  /// at a relaxed solution, and lambda alone cannot decide (it vanishes for every region at a
-  /// switching boundary). Integrator and OCP report switches where this set changes.
+  /// Active regions of element n at the NLP point w: r is active where sum_m theta_{n,m,r} >
+  /// sum_m |lambda_{n,m,r}| over the element's stages (the factor of a complementarity pair that
+  /// is zero is the smaller one, whatever complementarity the homotopy reached; |.| for free-sign
+  /// stage lambdas) and theta_{n,m,r} > kActiveThetaTol at some stage (at a stage on a switching
+  /// boundary both factors are ~0, and theta there may be any small value). theta alone cannot
+  /// decide: an inactive region has theta ~ sigma / lambda at a relaxed solution, above 1e-6
+  /// near a switch with complementarity_tol 1e-9 and almost everywhere with 1e-6; nor can lambda
+  /// alone (it vanishes for every region at a switching boundary). Integrator and OCP report
+  /// switches where this set changes.
   std::vector<int> active_set(const double* w, int n) const;
+  /// Region r at stage m of element n: theta_{n,m,r} > max(|lambda_{n,m,r}|, kActiveThetaTol),
+  /// the stage-wise form of active_set().
+  bool stage_active(const double* w, int n, int m, int r) const;
   static constexpr double kActiveThetaTol = 1e-6;
 
   // ---- sliding exits (docs/formulation.md, "Leaving a sliding mode") ----
@@ -133,25 +141,28 @@ class FesdInterval {
   };
   /// The sliding exits inside the interval at the NLP point w: every exit between elements n and
   /// n+1 (exit_regions of their active sets), and an exit inside the last element (r active
-  /// there together with another region of its subsystem, but at its end theta_r <=
-  /// kExitThetaTol and lambda_r > kExitLambdaTol: the state left the surface inside the element,
-  /// which cross complementarity tolerates because both factors are small there). The latter is
-  /// pinned in the element before if that one slides on r too; or, with control_jump_at_end (an
-  /// OCP interval, whose control changes at its end), in the last element without theta_zero:
-  /// the mode is kept to the interval end, where the new control may end it.
+  /// there together with another region of its subsystem, but not at its end point
+  /// (stage_active): the state left the surface inside the element, which cross complementarity
+  /// tolerates because both factors are small near an exit). The latter is pinned in the element
+  /// before if that one slides on r too; or, with control_jump_at_end (an OCP interval, whose
+  /// control changes at its end), in the last element without theta_zero: the mode is kept to
+  /// the interval end, where the new control may end it.
   std::vector<ExitPin> exits_to_pin(const double* w, bool control_jump_at_end) const;
-  /// The variable bounds that pin an exit: lambda_{n,m,r} = 0 at every stage (element n stays on
-  /// the surface) and, with theta_zero, theta_{n,n_s,r} = 0 (the region's weight reaches 0 at
-  /// t_{n+1}).
-  std::vector<nlp::Bound> pin_exit(const ExitPin& pin) const;
+  /// The variable bounds of the pinned re-solve: the active set of every element is fixed (that
+  /// of active_set() at w, with each pin's region kept in its element and, with theta_zero,
+  /// removed from the next): theta_{n,m,r} = 0 off the set, lambda_{n,m,r} = 0 on it at every
+  /// lambda point of the element (start, stages, end boundary), and for each pin with theta_zero
+  /// theta_{n,n_s,r} = 0 (the region's weight reaches 0 at t_{n+1}). The complementarity
+  /// constraints then hold exactly and the re-solve is a smooth problem in h and the stage
+  /// values, the square system of Thm 15 plus the free element lengths. Fixing only the pinned
+  /// exits left IPOPT to wander between degenerate complementarity branches (the belt of
+  /// docs/formulation.md: converged to local infeasibility).
+  std::vector<nlp::Bound> pin_bounds(const double* w, const std::vector<ExitPin>& pins) const;
   /// Between two integration steps an exit is pinned only when theta of the leaving region at
-  /// the end of the step before exceeds this (below it the exit is early by ~ theta / |d theta /
-  /// dt|, an error ~1e-12 in the state); else the first element would have to slide on without
-  /// the region and shrink to length 0.
+  /// the end of the step before exceeds this and its lambda there (below it the exit is early by
+  /// ~ theta / |d theta / dt|, an error ~1e-12 in the state); else the first element would have
+  /// to slide on without the region and shrink to length 0.
   static constexpr double kExitThetaTol = 1e-6;
-  /// lambda at the end of an element above which the state has left the surface (the state
-  /// error is about this size); the NLP's own noise in lambda is ~1e-10.
-  static constexpr double kExitLambdaTol = 1e-9;
   /// Recomputes the lifted sums of step equilibration (if any) in the guess w from its other
   /// entries; call after changing the guess of lambda or theta.
   void update_lifted_guess(std::vector<double>& w) const;

@@ -238,8 +238,9 @@ class Integrator {
       solved = &fallback(k, r, sp);
       hr = retry_sparse(*solved, hopt, rows);
     }
-    if (hr.status == Status::Success && d_.pin_sliding_exits && solved->iv->can_pin_exits())
-      pin_exits(*solved, hr, rows);
+    std::vector<int> unlocated;  // regions whose exit in this step could not be pinned
+    if (hr.status == Status::Success && solved->iv->can_pin_exits())
+      unlocated = resolve_fixed(*solved, hr, rows);
     res_.homotopy.push_back(std::move(rows));
     last_ = hr;
     if (hr.status != Status::Success) {
@@ -247,7 +248,10 @@ class Integrator {
       return false;
     }
     res_.summary.max_comp_residual = std::max(res_.summary.max_comp_residual, hr.comp_residual);
+    const std::size_t first_switch = res_.switches.size();
+    const double t_step = t_;
     accept(*solved);
+    if (!unlocated.empty()) mark_unlocated(first_switch, t_step, unlocated);
     return true;
   }
 
@@ -276,22 +280,26 @@ class Integrator {
            mode != MpccMode::FischerBurmeister;
   }
 
-  /// Sliding exits of a solved step (docs/formulation.md): the exits inside it
-  /// (FesdInterval::exits_to_pin), and an exit at its start where the previous step ended with
-  /// theta > kExitThetaTol of the leaving region, are pinned and the last NLP solved again; if
-  /// that fails, the unpinned solution stays. On success hr's complementarity residual becomes
-  /// the pinned solution's.
-  void pin_exits(StepProblem& sp, mpcc::HomotopyResult& hr, std::vector<HomotopyRow>& rows) {
+  /// The re-solve of a solved step with its active set fixed (HomotopyOptions::fix_active_set;
+  /// docs/formulation.md): every element keeps the active set the homotopy found, the sliding
+  /// exits (pin_sliding_exits) are pinned in the same solve: the exits inside the step
+  /// (FesdInterval::exits_to_pin) and one at its start where the step before ended with the
+  /// leaving region still active (step_start_exits). If it fails, the homotopy's solution stays.
+  /// On success hr's complementarity residual becomes the re-solve's. Returns the regions whose
+  /// exit could not be pinned.
+  std::vector<int> resolve_fixed(StepProblem& sp, mpcc::HomotopyResult& hr,
+                                 std::vector<HomotopyRow>& rows) {
     using discretization::FesdInterval;
     const FesdInterval& iv = *sp.iv;
     const std::vector<double>& w = sp.mpcc.solution();
-    std::vector<FesdInterval::ExitPin> pins =
-        iv.exits_to_pin(w.data(), /*control_jump_at_end=*/false);
-    const double h0_min = step_start_exits(iv, w, pins);
-    if (pins.empty()) return;
-    std::vector<nlp::Bound> bounds;
-    for (const auto& pin : pins)
-      for (const nlp::Bound& b : iv.pin_exit(pin)) bounds.push_back(b);
+    std::vector<FesdInterval::ExitPin> pins;
+    double h0_min = 0;
+    if (d_.pin_sliding_exits) {
+      pins = iv.exits_to_pin(w.data(), /*control_jump_at_end=*/false);
+      h0_min = step_start_exits(iv, w, pins);
+    }
+    if (pins.empty() && !options_.homotopy.fix_active_set) return {};
+    std::vector<nlp::Bound> bounds = iv.pin_bounds(w.data(), pins);
     const int h0 = iv.h(0);
     if (h0_min > 0 && h0_min < sp.mpcc.upper(h0))
       bounds.push_back({h0, std::max(sp.mpcc.lower(h0), h0_min), sp.mpcc.upper(h0)});
@@ -300,11 +308,36 @@ class Integrator {
         sp.mpcc.solve_again(*solver_, options_.homotopy, bounds, n_pins);
     account(again, rows);
     if (again.status == Status::Success) {
+      ++res_.summary.active_set_solves;
       res_.summary.pinned_exits += n_pins;
       hr.comp_residual = again.comp_residual;
-    } else {
-      ++res_.summary.pin_failures;
+      return {};
     }
+    if (n_pins == 0) {
+      ++res_.summary.active_set_failures;
+      return {};
+    }
+    ++res_.summary.pin_failures;
+    std::vector<int> regions;
+    for (const auto& pin : pins) regions.push_back(pin.r);
+    return regions;
+  }
+
+  /// Marks the exits among the switches from index `first` on (those of the step that started at
+  /// t_step) whose region could not be pinned, and says so in the summary's warnings.
+  void mark_unlocated(std::size_t first, double t_step, const std::vector<int>& regions) {
+    using discretization::FesdInterval;
+    for (std::size_t i = first; i < res_.switches.size(); ++i) {
+      SwitchEvent& s = res_.switches[i];
+      for (int r : FesdInterval::exit_regions(model_, s.before, s.after))
+        if (std::find(regions.begin(), regions.end(), r) != regions.end()) s.located = false;
+    }
+    res_.summary.warnings.push_back(fmt::format(
+        "the sliding exit{} of region{} {} in the step from t = {:.6g} could not be located (the "
+        "re-solve with the exit pinned failed): its switch time may be off by up to one element "
+        "length, {:.3g}; try another N_sim",
+        regions.size() == 1 ? "" : "s", regions.size() == 1 ? "" : "s", fmt::join(regions, ", "),
+        t_step, T_step_ / d_.N_FE));
   }
 
   /// The previous step ended sliding with theta_r > 0 (guess_.theta: its last stage), and this
@@ -322,7 +355,7 @@ class Integrator {
     const int n_s = d_.n_s;
     for (int r : FesdInterval::exit_regions(model_, res_.active_set.back(), first)) {
       const double th_end = guess_.theta[r];
-      if (th_end <= FesdInterval::kExitThetaTol) continue;
+      if (th_end <= std::max(FesdInterval::kExitThetaTol, guess_.lambda[r])) continue;
       // theta_r at the first and last stage of the previous element (res_.theta, res_.t_stage).
       const std::size_t last = res_.theta.size() - 1, first_stage = last + 1 - n_s;
       const double dt = res_.t_stage[last] - res_.t_stage[first_stage];
@@ -503,6 +536,7 @@ std::string IntegratorResult::full_report() const {
   const std::size_t n_steps = homotopy.size() - static_cast<std::size_t>(summary.refine_attempts) -
                               static_cast<std::size_t>(summary.split_steps);
   os << fmt::format("  integration steps    {}  ({} finite elements)\n", n_steps, h.size());
+  os << format_warnings(summary);
   os << format_work(summary, n_steps == 0 ? 1.0 : static_cast<double>(n_steps));
   return os.str();
 }

@@ -57,15 +57,21 @@ json stats(const Summary& s) {
               {"fallback_steps", s.fallback_steps},
               {"refined_steps", s.refined_steps},
               {"split_steps", s.split_steps},
+              {"active_set_solves", s.active_set_solves},
+              {"active_set_failures", s.active_set_failures},
               {"pinned_exits", s.pinned_exits},
-              {"pin_failures", s.pin_failures}};
+              {"pin_failures", s.pin_failures},
+              {"warnings", s.warnings}};
 }
 
 json switches(const std::vector<SwitchEvent>& events) {
   json a = json::array();
   for (const SwitchEvent& e : events) {
-    a.push_back(
-        json{{"t", number(e.t)}, {"element", e.element}, {"before", e.before}, {"after", e.after}});
+    a.push_back(json{{"t", number(e.t)},
+                     {"element", e.element},
+                     {"before", e.before},
+                     {"after", e.after},
+                     {"located", e.located}});
   }
   return a;
 }
@@ -80,6 +86,7 @@ json homotopy_row(const HomotopyRow& r) {
               {"nlp_status", r.nlp_status},
               {"cpu_s", number(r.cpu_s)},
               {"linear_solver", r.linear_solver},
+              {"active_set_fixed", r.active_set_fixed},
               {"pinned_exits", r.pinned_exits}};
 }
 

@@ -185,6 +185,7 @@ HomotopyResult Problem::solve_again(nlp::NlpSolver& solver, const HomotopyOption
   nlp_.x_ub = x_ub;
   res.comp_residual = comp_residual(trial.x.data(), residual_pairs_);
   record(res, r, next_row_++, sigma_);
+  res.rows.back().active_set_fixed = true;
   res.rows.back().pinned_exits = pinned_exits;
   res.status = final_status(r.success, r.eval_error, res.comp_residual, o.complementarity_tol);
   if (res.status == Status::Success) it_ = std::move(trial);

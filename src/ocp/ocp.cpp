@@ -502,20 +502,27 @@ OcpResult solve(const Ocp& ocp, const OcpOptions& options) {
     // element of an interval is kept on the surface up to the boundary instead.
     std::vector<nlp::Bound> bounds;
     int n_pins = 0;
-    for (const auto& iv : b->iv)
-      for (const auto& pin : iv->exits_to_pin(mp.solution().data(), /*control_jump_at_end=*/true)) {
-        ++n_pins;
-        for (const nlp::Bound& bd : iv->pin_exit(pin)) bounds.push_back(bd);
-      }
+    const double* w = mp.solution().data();
+    for (const auto& iv : b->iv) {
+      const auto pins = iv->exits_to_pin(w, /*control_jump_at_end=*/true);
+      if (pins.empty()) continue;
+      n_pins += static_cast<int>(pins.size());
+      for (const nlp::Bound& bd : iv->pin_bounds(w, pins)) bounds.push_back(bd);
+    }
     if (n_pins > 0) {
       const mpcc::HomotopyResult again = mp.solve_again(*solver, options.homotopy, bounds, n_pins);
       if (options.on_homotopy_row) options.on_homotopy_row(again.rows.back());
       account(again);
       if (again.status == Status::Success) {
+        ++res.summary.active_set_solves;
         res.summary.pinned_exits = n_pins;
         hr.comp_residual = again.comp_residual;
       } else {
         ++res.summary.pin_failures;
+        res.summary.warnings.push_back(fmt::format(
+            "{} sliding exit{} could not be pinned (the re-solve failed): {} switch time{} may be "
+            "off by up to one element",
+            n_pins, n_pins == 1 ? "" : "s", n_pins == 1 ? "its" : "their", n_pins == 1 ? "" : "s"));
       }
     }
   }
@@ -569,6 +576,7 @@ std::string OcpResult::full_report(bool with_homotopy_table) const {
     os << "  homotopy\n" << homotopy_table_header();
     for (const auto& r : homotopy) os << format_homotopy_row(r);
   }
+  os << format_warnings(summary);
   os << format_work(summary);
   return os.str();
 }

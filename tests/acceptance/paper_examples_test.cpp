@@ -132,7 +132,8 @@ TEST(LeavingSliding, LeavesAtOneThenParabola) {
   EXPECT_NEAR(r.switches.back().t, 1.0, 1e-6);
   EXPECT_EQ(r.switches.back().after, std::vector<int>{0});
   EXPECT_NEAR(r.x_final()[0], (T - 1) * (T - 1) / 2, 1e-6);
-  EXPECT_NEAR(r.x_final()[1], T, 1e-12);
+  // The clock is exact up to the NLPs' equation residuals (IPOPT tol 1e-12 per step, 7 steps).
+  EXPECT_NEAR(r.x_final()[1], T, 1e-11);
 }
 
 // Example 3(c) on grids where the FESD equations alone let the integrator leave the sliding mode
