@@ -263,13 +263,28 @@ std::vector<std::pair<const toml::key*, const toml::node*>> in_file_order(const 
 }
 
 std::string key_hint(std::string_view key, std::span<const std::string_view> valid) {
-  // nosnoc's names (MATLAB and Python) and the paper's symbols that differ from the file keys.
-  static constexpr std::array<std::pair<std::string_view, std::string_view>, 22> kAliases{{
+  // Keys by meaning (lower case -> the file key, hinted where that key is valid): nosnoc's names
+  // (MATLAB and Python), the paper's symbols, and the other kind of problem's name of a key.
+  static constexpr std::pair<std::string_view, std::string_view> kAliases[] = {
       {"n_fe", "N_finite_elements"},
+      {"nfe", "N_finite_elements"},
+      {"nfe_list", "N_finite_elements"},
+      {"n_elements", "N_finite_elements"},
+      {"num_fe", "N_finite_elements"},
       {"max_homotopy_steps", "N_homotopy"},
       {"max_iter_homotopy", "N_homotopy"},
       {"comp_tol", "complementarity_tol"},
       {"terminal_time", "T_sim"},
+      {"terminal_time", "T"},
+      // [simulation] T_sim, N_sim, u against [ocp] T, N_stages, u_guess.
+      {"t", "T_sim"},
+      {"tf", "T_sim"},
+      {"tf", "T"},
+      {"t_sim", "T"},
+      {"n_sim", "N_stages"},
+      {"u", "u_guess"},
+      {"u_guess", "u"},
+      {"tol_ipopt", "tol"},
       {"irk_scheme", "rk_scheme"},
       {"cross_comp", "cross_comp_mode"},
       {"g_ind", "g"},
@@ -288,7 +303,7 @@ std::string key_hint(std::string_view key, std::span<const std::string_view> val
       {"g_terminal_ub", "ubg_terminal"},
       {"rho_terminal_p", "rho_terminal"},
       {"terminal_constraint", "relax_terminal_constraint"},
-  }};
+  };
   const std::string k = lower(key);
   std::vector<std::pair<int, std::string_view>> near;
   for (std::string_view v : valid) {
