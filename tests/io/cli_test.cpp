@@ -23,6 +23,7 @@ namespace fs = std::filesystem;
 
 const std::string kOscillator = FESD_SOURCE_DIR "/examples/oscillator.toml";
 const std::string kSensitivity = FESD_SOURCE_DIR "/examples/ocp_sensitivity.toml";
+const std::string kSlidingOcp = FESD_SOURCE_DIR "/examples/ocp_sliding_mode.toml";
 
 using fesd::testing::TempDir;
 
@@ -213,6 +214,45 @@ TEST(Cli, HelpGroupsOverridesByTable) {
   EXPECT_TRUE(contains(r.out, "--n_s INT")) << r.out;
   EXPECT_TRUE(contains(r.out, "1..9")) << r.out;
   EXPECT_TRUE(contains(r.out, "--ipopt.NAME VALUE")) << r.out;
+  // [model] x0 and p (issue 13, 3), for every command; u and u_guess as lists.
+  for (const char* command : {"simulate", "solve", "check"}) {
+    const CliRun h = run_cli({command, "--help"});
+    EXPECT_TRUE(contains(h.out, "Overrides [model]")) << command;
+    EXPECT_TRUE(contains(h.out, "--x0 V1,V2,...")) << command;
+    EXPECT_TRUE(contains(h.out, "--p NAME=VALUE")) << command;
+  }
+  EXPECT_TRUE(contains(r.out, "--u V1,V2,...")) << r.out;
+  EXPECT_TRUE(contains(run_cli({"solve", "--help"}).out, "--u_guess V1,V2,..."));
+}
+
+// Parameters, x0, u and u_guess from the command line reach the problem (issue 13, 3): the
+// header of `check` shows them; bad values are one-line errors naming the option.
+TEST(Cli, ModelOverrides) {
+  const CliRun r = run_cli({"check", kOscillator, "--p", "omega=3", "--x0", "-1,2", "--model.p",
+                            "omega=4", "--p=omega=5"});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(contains(r.out, "x0          [-1, 2]")) << r.out;
+  EXPECT_TRUE(contains(r.out, "p           omega = 5")) << r.out;
+  const CliRun ocp = run_cli({"check", kSlidingOcp, "--u_guess", "0.5,-0.5", "--x0=1,2,0,0"});
+  EXPECT_EQ(ocp.code, 0) << ocp.err;
+  EXPECT_TRUE(contains(ocp.out, "u guess     u1 = 0.5, u2 = -0.5")) << ocp.out;
+  EXPECT_TRUE(contains(ocp.out, "x0          [1, 2, 0, 0]")) << ocp.out;
+  for (const auto& [args, message] : std::vector<std::pair<std::vector<std::string>, std::string>>{
+           {{"--p", "omgea=3"}, "--p omgea=3: unknown parameter 'omgea' (did you mean 'omega'?)"},
+           {{"--omega", "3"}, "('omega' is a parameter of model.p: write --p omega=3)"},
+           {{"--x0", "1"},
+            "--x0 = 1: wrong length (expected 2 numbers, one per state in model.x, "
+            "got 1)"},
+           {{"--T", "2"}, "--T = 2: unknown option 'T' (did you mean 'T_sim'?)"},
+           {{"--u_guess", "0"}, "unknown option 'u_guess' (did you mean 'u'?)"}}) {
+    std::vector<std::string> argv{"simulate", kOscillator};
+    argv.insert(argv.end(), args.begin(), args.end());
+    const CliRun bad = run_cli(argv);
+    EXPECT_EQ(bad.code, 2) << bad.err;
+    EXPECT_EQ(bad.err.rfind("fesd: error: " + args.front(), 0), 0U) << bad.err;
+    EXPECT_TRUE(contains(bad.err, message)) << bad.err;
+    EXPECT_EQ(bad.err_lines(), 1) << bad.err;
+  }
 }
 
 TEST(Cli, BadPlotExtensionExits2BeforeSolving) {
