@@ -616,6 +616,8 @@ TEST(CliDocs, EveryCommandLineSpanRunsAsDocumented) {
 // REAL SOLVES (the README's commands, a few seconds each): run as written, from a scratch
 // directory (the outputs land there).
 TEST(CliDocs, ReadmeCommandsRun) {
+  if (run_shell("command -v gnuplot >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "gnuplot is not installed (the README's commands write plots)";
   const std::string readme = read_file(FESD_SOURCE_DIR "/README.md");
   TempDir dir;
   int run = 0;
