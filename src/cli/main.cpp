@@ -129,7 +129,9 @@ using Scope = fesd::registry::Use;
 
 constexpr const char* kOverridesFooter =
     "Overrides act as if written in the problem file. A key may be qualified by its table "
-    "(--discretization.n_s 3); --ipopt.NAME VALUE or --ipopt NAME=VALUE sets any IPOPT option.";
+    "(--discretization.n_s 3, --model.x0 1,0); --ipopt.NAME VALUE or --ipopt NAME=VALUE sets any "
+    "IPOPT option. Lists are comma-separated numbers (--x0 0.5,-1; --x0=-1,2 when the first is "
+    "negative).";
 
 /// "Overrides [discretization]": one --help group per problem-file table.
 std::string override_group(fesd::registry::Table table) {
@@ -143,6 +145,9 @@ struct Overrides {
   std::vector<std::string> values;
   std::vector<CLI::Option*> options;
   std::vector<std::string> ipopt;
+  std::string x0;  ///< --x0 V1,V2,... ([model] x0)
+  CLI::Option* x0_option = nullptr;
+  std::vector<std::string> parameters;  ///< --p NAME=VALUE, repeatable ([model] p)
   /// Arguments CLI11 did not recognize (the command allows extras): an unknown --KEY VALUE goes
   /// to fesd::apply_override, whose message names the nearest option ("unknown option 'n_S'
   /// (did you mean 'n_s'?)").
@@ -151,6 +156,16 @@ struct Overrides {
   /// Adds the options of `scope` (Both: every option, for `check`, which reads either kind).
   void add_to(CLI::App& app, Scope scope) {
     app.allow_extras();
+    x0_option = app.add_option("--x0", x0,
+                               "initial state x(0) (of an OCP: its guess if free), one number per "
+                               "state of model.x, comma-separated")
+                    ->type_name("V1,V2,...")
+                    ->multi_option_policy(CLI::MultiOptionPolicy::TakeLast)
+                    ->group("Overrides [model]");
+    app.add_option("--p", parameters, "the value of a parameter of model.p (repeatable)")
+        ->type_name("NAME=VALUE")
+        ->allow_extra_args(false)
+        ->group("Overrides [model]");
     for (const fesd::registry::Option& o : fesd::registry::all())
       if (o.overridable && fesd::registry::has(o, scope)) keys.push_back(&o);
     values.resize(keys.size());
@@ -159,8 +174,9 @@ struct Overrides {
       const fesd::registry::Option& o = *keys[i];
       std::string names = fmt::format("--{}", o.key);
       if (!o.alias.empty()) names += fmt::format(",--{}", o.alias);
+      const bool list = o.key == "u" || o.key == "u_guess";  // comma-separated numbers
       options[i] = app.add_option(names, values[i], fesd::registry::help_text(o))
-                       ->type_name(type_name(o.kind))
+                       ->type_name(list ? "V1,V2,..." : type_name(o.kind))
                        ->multi_option_policy(CLI::MultiOptionPolicy::TakeLast)
                        ->group(override_group(o.table));
     }
@@ -190,6 +206,8 @@ struct Overrides {
   /// any IPOPT option name is accepted).
   std::vector<std::pair<std::string, std::string>> pairs() const {
     std::vector<std::pair<std::string, std::string>> out;
+    if (x0_option != nullptr && x0_option->count() > 0) out.emplace_back("x0", x0);
+    for (const std::string& item : parameters) out.emplace_back("p", item);
     for (std::size_t i = 0; i < keys.size(); ++i) {
       if (options[i] != nullptr && options[i]->count() > 0) {
         out.emplace_back(keys[i]->key, values[i]);
@@ -242,7 +260,7 @@ std::vector<std::string> cli11_args(int argc, char** argv) {
     const fesd::registry::Option* o = nullptr;
     for (const fesd::registry::Option& x : fesd::registry::all())
       if (fesd::registry::to_string(x.table) == table && (x.key == key || x.alias == key)) o = &x;
-    if (o != nullptr && o->overridable) {
+    if ((o != nullptr && o->overridable) || (table == "model" && (key == "x0" || key == "p"))) {
       args.push_back("--" + key + rest);
     } else if (table == "ipopt" && !key.empty() && (!rest.empty() || i + 1 < argc)) {
       args.push_back("--ipopt");

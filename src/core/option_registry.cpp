@@ -188,7 +188,9 @@ std::vector<Option> build() {
   o.push_back(input(kOcp, "ubx", ocp, "state upper bounds", "ubx"));
   o.push_back(input(kOcp, "lbu", ocp, "control lower bounds", "lbu"));
   o.push_back(input(kOcp, "ubu", ocp, "control upper bounds", "ubu"));
-  o.push_back(input(kOcp, "u_guess", ocp, "initial guess of every control", "u0"));
+  o.push_back(input(kOcp, "u_guess", ocp,
+                    "initial guess of every control, one per control (comma-separated)", "u0",
+                    true));
   o.push_back(input(kOcp, "lbx0", ocp, "lower bounds of a free initial state", ""));
   o.push_back(input(kOcp, "ubx0", ocp, "upper bounds of a free initial state", ""));
   with(scalar<&T::ocp, &Ocp::terminal_constraint>(

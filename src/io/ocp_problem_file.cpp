@@ -262,10 +262,16 @@ void apply_override(OcpProblem& problem, std::string_view key, std::string_view 
   if (set_scalar_override(arg, target_of(updated))) {
     // One number for every control interval replaces a per-interval list.
     if (arg.option->key == "N_finite_elements") updated.ocp.N_FE.clear();
+  } else if (arg.option != nullptr && arg.option->key == "u_guess") {
+    updated.ocp.u_guess = override_vector(arg.head, arg.value, updated.ocp.model.n_u(),
+                                          "ocp.u_guess", "one per control in model.u");
+  } else if (set_model_override(arg, updated.ocp.model, updated.has_clock, updated.ocp.x0,
+                                updated.ocp.p)) {
+    // [model] x0 (the guess of a free x0) or one parameter
   } else if (arg.table == "ipopt" && !arg.key.empty()) {
     set_ipopt_option(updated.options.nlp.extra, arg.key, arg.value);
   } else {
-    unknown_override(arg, kKind);
+    unknown_override(arg, kKind, updated.ocp.model);
   }
 
   ocp_detail::OcpInputErrors errors = ocp_detail::check_input(updated.ocp, updated.options);

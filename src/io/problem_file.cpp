@@ -125,26 +125,14 @@ void apply_override(SimulationProblem& problem, std::string_view key, std::strin
     if (!std::isfinite(*d)) override_error(head, "must be finite");
     if (updated.has_clock) updated.x0[updated.x0.size() - 1] = *d;
   } else if (input == "u") {
-    std::vector<double> u;
-    std::string_view rest = value;
-    while (!rest.empty()) {
-      const std::size_t comma = rest.find(',');
-      const auto d = parse_double(trim(rest.substr(0, comma)));
-      if (!d) override_error(head, "expected comma-separated numbers, one per control");
-      if (!std::isfinite(*d)) override_error(head, "must be finite");
-      u.push_back(*d);
-      rest = comma == std::string_view::npos ? std::string_view{} : rest.substr(comma + 1);
-    }
-    if (static_cast<int>(u.size()) != updated.model.n_u())
-      override_error(
-          head,
-          fmt::format("wrong length (expected {}, one per control, got {})",
-                      count(static_cast<std::size_t>(updated.model.n_u()), "number"), u.size()));
-    updated.u = Eigen::Map<const Eigen::VectorXd>(u.data(), static_cast<Eigen::Index>(u.size()));
+    updated.u =
+        override_vector(head, value, updated.model.n_u(), "simulation.u", "one per control");
+  } else if (set_model_override(arg, updated.model, updated.has_clock, updated.x0, updated.p)) {
+    // [model] x0 or one parameter
   } else if (arg.table == "ipopt" && !arg.key.empty()) {
     set_ipopt_option(updated.options.nlp.extra, arg.key, value);
   } else {
-    unknown_override(arg, kKind);
+    unknown_override(arg, kKind, updated.model);
   }
 
   const std::vector<std::string> errors = validate_all(updated);

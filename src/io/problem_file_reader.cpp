@@ -262,14 +262,30 @@ std::vector<std::pair<const toml::key*, const toml::node*>> in_file_order(const 
   return entries;
 }
 
-std::string key_hint(std::string_view key, std::span<const std::string_view> valid) {
-  // nosnoc's names (MATLAB and Python) and the paper's symbols that differ from the file keys.
-  static constexpr std::array<std::pair<std::string_view, std::string_view>, 22> kAliases{{
+std::string key_hint(std::string_view key, std::span<const std::string_view> valid,
+                     std::string_view all) {
+  // Keys by meaning (lower case -> the file key, hinted where that key is valid): nosnoc's names
+  // (MATLAB and Python), the paper's symbols, and the other kind of problem's name of a key.
+  static constexpr std::pair<std::string_view, std::string_view> kAliases[] = {
       {"n_fe", "N_finite_elements"},
+      {"nfe", "N_finite_elements"},
+      {"nfe_list", "N_finite_elements"},
+      {"n_elements", "N_finite_elements"},
+      {"num_fe", "N_finite_elements"},
       {"max_homotopy_steps", "N_homotopy"},
       {"max_iter_homotopy", "N_homotopy"},
       {"comp_tol", "complementarity_tol"},
       {"terminal_time", "T_sim"},
+      {"terminal_time", "T"},
+      // [simulation] T_sim, N_sim, u against [ocp] T, N_stages, u_guess.
+      {"t", "T_sim"},
+      {"tf", "T_sim"},
+      {"tf", "T"},
+      {"t_sim", "T"},
+      {"n_sim", "N_stages"},
+      {"u", "u_guess"},
+      {"u_guess", "u"},
+      {"tol_ipopt", "tol"},
       {"irk_scheme", "rk_scheme"},
       {"cross_comp", "cross_comp_mode"},
       {"g_ind", "g"},
@@ -288,7 +304,7 @@ std::string key_hint(std::string_view key, std::span<const std::string_view> val
       {"g_terminal_ub", "ubg_terminal"},
       {"rho_terminal_p", "rho_terminal"},
       {"terminal_constraint", "relax_terminal_constraint"},
-  }};
+  };
   const std::string k = lower(key);
   std::vector<std::pair<int, std::string_view>> near;
   for (std::string_view v : valid) {
@@ -316,7 +332,7 @@ std::string key_hint(std::string_view key, std::span<const std::string_view> val
   std::string list;
   if (near.empty()) {
     for (std::string_view v : valid) list += (list.empty() ? "" : ", ") + std::string(v);
-    return fmt::format("(valid keys: {})", list);
+    return fmt::format("({}: {})", all, list);
   }
   const std::size_t n = std::min<std::size_t>(near.size(), 3);
   for (std::size_t i = 0; i < n; ++i) {
@@ -620,11 +636,12 @@ OverrideArg parse_override_arg(std::string_view key, std::string_view value, reg
   OverrideArg a;
   while (!key.empty() && key.front() == '-') key.remove_prefix(1);
   a.value = trim(value);
-  a.head = fmt::format("--{} = {}", key, a.value);
+  // "--p omega=2" as written on the command line; "--n_s = 3" for every other key.
+  a.head = fmt::format("--{}{}{}", key, key == "p" || key == "model.p" ? " " : " = ", a.value);
   if (const std::size_t dot = key.find('.'); dot != std::string_view::npos) {
     a.table = key.substr(0, dot);
     key = key.substr(dot + 1);
-    std::vector<std::string_view> tables;
+    std::vector<std::string_view> tables{"model"};  // x0 and p (set_model_override)
     for (registry::Table t : registry::tables(kind)) tables.push_back(registry::to_string(t));
     if (std::find(tables.begin(), tables.end(), a.table) == tables.end())
       override_error(a.head,
@@ -658,12 +675,83 @@ void set_ipopt_option(std::vector<std::pair<std::string, std::string>>& extra, s
     extra.emplace_back(std::string(key), value);
 }
 
-void unknown_override(const OverrideArg& a, registry::Use kind) {
+Eigen::VectorXd override_vector(const std::string& head, std::string_view value, int n,
+                                std::string_view path, std::string_view what) {
+  std::vector<double> v;
+  std::string_view rest = value;
+  while (!rest.empty()) {
+    const std::size_t comma = rest.find(',');
+    const auto d = parse_double(trim(rest.substr(0, comma)));
+    if (!d) override_error(head, fmt::format("expected comma-separated numbers, {}", what));
+    if (!std::isfinite(*d))
+      override_error(
+          head, fmt::format("{} = {}: must be finite", index(path, v.size()), format_number(*d)));
+    v.push_back(*d);
+    rest = comma == std::string_view::npos ? std::string_view{} : rest.substr(comma + 1);
+  }
+  if (static_cast<int>(v.size()) != n)
+    override_error(head, fmt::format("wrong length (expected {}, {}, got {})",
+                                     count(static_cast<std::size_t>(n), "number"), what, v.size()));
+  return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
+}
+
+bool set_model_override(const OverrideArg& a, Pss& model, bool has_clock, Eigen::VectorXd& x0,
+                        Eigen::VectorXd& p) {
+  if (!a.table.empty() && a.table != "model") return false;
+  if (a.key == "x0") {
+    const int n_x_user = model.n_x() - (has_clock ? 1 : 0);  // the clock keeps its start value
+    x0.head(n_x_user) =
+        override_vector(a.head, a.value, n_x_user, "model.x0", "one per state in model.x");
+    return true;
+  }
+  if (a.key != "p") return false;
+  const std::vector<std::string>& names = model.parameter_names;
+  const std::size_t eq = a.value.find('=');
+  const std::string name = trim(std::string_view(a.value).substr(0, eq));
+  if (eq == std::string::npos || name.empty())
+    override_error(a.head,
+                   fmt::format("expected NAME=VALUE, a parameter of model.p and its value (e.g. "
+                               "--p {}=2.5)",
+                               names.empty() ? "k" : names.front()));
+  const auto it = std::find(names.begin(), names.end(), name);
+  if (it == names.end()) {
+    if (names.empty())
+      override_error(a.head, fmt::format("unknown parameter '{}' (the model has no parameters: "
+                                         "model.p is empty)",
+                                         name));
+    const std::vector<std::string_view> valid(names.begin(), names.end());
+    override_error(a.head, fmt::format("unknown parameter '{}' {}", name,
+                                       key_hint(name, valid, "parameters in model.p")));
+  }
+  const std::string path = join("model.p", name);
+  const std::string text = trim(std::string_view(a.value).substr(eq + 1));
+  const auto d = parse_double(text);
+  if (!d) override_error(a.head, fmt::format("{}: expected a number, got \"{}\"", path, text));
+  if (!std::isfinite(*d))
+    override_error(a.head, fmt::format("{} = {}: must be finite", path, format_number(*d)));
+  const auto i = static_cast<Eigen::Index>(it - names.begin());
+  p[i] = *d;
+  model.p_default[i] = *d;
+  return true;
+}
+
+void unknown_override(const OverrideArg& a, registry::Use kind, const Pss& model) {
   if (a.option != nullptr && !a.option->overridable)
-    override_error(a.head, fmt::format("unknown option '{}' (expressions, bounds and guesses can "
-                                       "only be set in the file)",
+    override_error(a.head, fmt::format("unknown option '{}' (expressions and bounds can only be "
+                                       "set in the file)",
                                        a.key));
+  const bool model_key = std::find(kModelKeys.begin(), kModelKeys.end(), a.key) != kModelKeys.end();
+  if (model_key && (a.table == "model" || (a.table.empty() && a.key != "u" && a.key != "x")))
+    override_error(a.head, fmt::format("unknown option '{}' (model.{} can only be set in the file; "
+                                       "the [model] overrides are x0 and p)",
+                                       a.key, a.key));
+  const std::vector<std::string>& parameters = model.parameter_names;
+  if (a.table.empty() && std::find(parameters.begin(), parameters.end(), a.key) != parameters.end())
+    override_error(a.head, fmt::format("unknown option '{}' ('{}' is a parameter of model.p: write "
+                                       "--p {}={})",
+                                       a.key, a.key, a.key, a.value));
   std::vector<std::string_view> valid;
+  if (a.table.empty() || a.table == "model") valid = {"x0", "p"};
   for (const registry::Option& o : registry::all()) {
     if (!o.overridable || !registry::has(o, kind)) continue;
     if (!a.table.empty() && registry::to_string(o.table) != a.table) continue;

@@ -44,8 +44,10 @@ std::string count(std::size_t n, std::string_view noun);
 bool is_identifier(std::string_view s);
 /// Entries of a table in the order they were written (toml++ keeps tables sorted by key).
 std::vector<std::pair<const toml::key*, const toml::node*>> in_file_order(const toml::table& t);
-/// "(did you mean 'n_s'?)" with the nearest valid keys, or "(valid keys: ...)" if none is near.
-std::string key_hint(std::string_view key, std::span<const std::string_view> valid);
+/// "(did you mean 'n_s'?)" with the nearest valid keys (by spelling, or by meaning: nosnoc's names
+/// and synonyms such as T for T_sim), or "(<all>: ...)" listing them if none is near.
+std::string key_hint(std::string_view key, std::span<const std::string_view> valid,
+                     std::string_view all = "valid keys");
 
 /// The file's text; throws ProblemFileError "<path>: cannot read problem file (...)".
 std::string read_problem_text(const std::string& path);
@@ -289,8 +291,18 @@ bool set_scalar_override(const OverrideArg& a, const registry::OptionTarget& tar
 /// Sets the IPOPT option `key` to `value` in `extra`, replacing an earlier value.
 void set_ipopt_option(std::vector<std::pair<std::string, std::string>>& extra, std::string_view key,
                       const std::string& value);
-/// "unknown option 'n_S' (did you mean 'n_s'?)"; for a key that only a file can set, says so.
-[[noreturn]] void unknown_override(const OverrideArg& a, registry::Use kind);
+/// Comma-separated numbers ("0.5, -2", "" for none) as an override value of `path` ("model.x0"):
+/// exactly n of them (`what`: "one per state"), all finite; throws InvalidOption "<head>: ...".
+Eigen::VectorXd override_vector(const std::string& head, std::string_view value, int n,
+                                std::string_view path, std::string_view what);
+/// The [model] overrides both kinds of problem have: "x0" (n_x numbers, the states of model.x;
+/// a clock keeps its start value) and "p" ("NAME=VALUE", one parameter of model.p, also stored
+/// as model.p_default), with or without the "model." prefix. False for any other key.
+bool set_model_override(const OverrideArg& a, Pss& model, bool has_clock, Eigen::VectorXd& x0,
+                        Eigen::VectorXd& p);
+/// "unknown option 'n_S' (did you mean 'n_s'?)"; for a key that only a file can set, says so; for
+/// a parameter name of `model`, shows the --p form.
+[[noreturn]] void unknown_override(const OverrideArg& a, registry::Use kind, const Pss& model);
 /// Joins the validation messages of an override; the overridden key's own "table.key = v: "
 /// prefix is dropped (the head already names it).
 [[noreturn]] void throw_override_errors(const OverrideArg& a,

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <iterator>
 #include <new>
 #include <numbers>
 #include <string>
@@ -87,6 +88,20 @@ constexpr Function kFunctions[] = {
     {"log", 1, Op::kLog},   {"sqrt", 1, Op::kSqrt}, {"tanh", 1, Op::kTanh}, {"abs", 1, Op::kAbs},
     {"sinh", 1, Op::kSinh}, {"cosh", 1, Op::kCosh}, {"atan", 1, Op::kAtan}, {"pow", 2, Op::kPow},
 };
+
+/// Nonsmooth functions people write for a switch (lower case): not in the language, because a
+/// switch must be a region boundary that FESD can locate (call() explains the region form).
+constexpr std::string_view kNonsmoothFunctions[] = {"sign", "sgn",   "signum",    "min",    "max",
+                                                    "fmin", "fmax",  "heaviside", "step",   "floor",
+                                                    "ceil", "round", "if_else",   "ifelse", "relu"};
+
+bool is_nonsmooth_function(std::string_view name) {
+  std::string lower(name);
+  for (char& ch : lower)
+    if (ch >= 'A' && ch <= 'Z') ch = static_cast<char>(ch - 'A' + 'a');
+  return std::find(std::begin(kNonsmoothFunctions), std::end(kNonsmoothFunctions), lower) !=
+         std::end(kNonsmoothFunctions);
+}
 
 const Function* find_function(std::string_view name) {
   for (const Function& f : kFunctions)
@@ -664,6 +679,14 @@ class Parser {
         fail("'" + name + "' is a symbol, not a function, in " + quoted() + " (write '" + name +
              "*(...)' to multiply)");
       if (name == "pi") fail("'pi' is a constant, not a function, in " + quoted());
+      if (is_nonsmooth_function(name))
+        fail("'" + name_shown + "' in " + quoted() +
+             ": nonsmooth functions (sign, min, max, heaviside, step, ...) are not part of the "
+             "expression language; write the switch as regions, with switching functions c, a "
+             "sign matrix S and one vector field per region in F (one state: x' = -sign(x) is "
+             "c = [\"x\"], F = [[\"-1\"], [\"1\"]]; docs/problem-files.md, \"Nonsmooth "
+             "functions: regions\"). nosnoc's Heaviside step reformulation is a discretization "
+             "option of nosnoc, not a function in expressions");
       std::vector<std::string_view> names;
       std::string list;
       for (const Function& g : kFunctions) {

@@ -8,6 +8,7 @@
 // and the test loads it (with load_simulation_problem unless the header names the OCP loader) and
 // checks both. Overrides (apply_override) are checked inline below.
 #include <algorithm>
+#include <array>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -189,6 +190,42 @@ TEST_P(BadOverride, ThrowsInvalidOptionAndLeavesProblemUnchanged) {
   EXPECT_EQ(q.T_sim, fresh.T_sim);
   EXPECT_EQ(q.N_sim, fresh.N_sim);
   EXPECT_EQ(q.u, fresh.u);
+  EXPECT_EQ(q.x0, fresh.x0);
+}
+
+// Parameters: a model with one (issue 13, 3).
+TEST(BadParameterOverride, ThrowsInvalidOptionAndLeavesProblemUnchanged) {
+  constexpr const char* kWithP = R"toml(
+[model]
+x = ["x"]
+p = { omega = 2.0, zeta = 0.1 }
+c = ["x"]
+F = [["-omega"], ["zeta"]]
+x0 = [0]
+[simulation]
+T_sim = 1
+)toml";
+  SimulationProblem q = parse_simulation_problem(kWithP, "p.toml");
+  for (const auto& [key, value, message] : std::vector<std::array<const char*, 3>>{
+           {"p", "omgea=3", "--p omgea=3: unknown parameter 'omgea' (did you mean 'omega'?)"},
+           {"p", "xi=3", "--p xi=3: unknown parameter 'xi' (parameters in model.p: omega, zeta)"},
+           {"p", "omega",
+            "--p omega: expected NAME=VALUE, a parameter of model.p and its value "
+            "(e.g. --p omega=2.5)"},
+           {"p", "=3", "--p =3: expected NAME=VALUE"},
+           {"p", "omega=nan", "--p omega=nan: model.p.omega = nan: must be finite"},
+           {"p", "omega=", "--p omega=: model.p.omega: expected a number, got \"\""},
+           {"p", "omega=1,2", "--p omega=1,2: model.p.omega: expected a number, got \"1,2\""},
+           {"zeta", "0.05",
+            "--zeta = 0.05: unknown option 'zeta' ('zeta' is a parameter of model.p: write "
+            "--p zeta=0.05)"}}) {
+    const Outcome o = outcome_of([&] { apply_override(q, key, value); });
+    EXPECT_EQ(o.kind, "InvalidOption") << o.message;
+    EXPECT_NE(o.message.find(message), std::string::npos)
+        << "message:  " << o.message << "\nexpected: " << message;
+  }
+  EXPECT_EQ(q.p, parse_simulation_problem(kWithP, "p.toml").p);
+  EXPECT_EQ(q.model.p_default, q.p);
 }
 
 INSTANTIATE_TEST_SUITE_P(
@@ -216,7 +253,34 @@ INSTANTIATE_TEST_SUITE_P(
         OverrideCase{"print_level", "99", "--print_level = 99: must be in 0..12"},
         OverrideCase{"u", "1, 2",
                      "--u = 1, 2: wrong length (expected 1 number, one per control, got 2)"},
-        OverrideCase{"u", "abc", "--u = abc: expected comma-separated numbers"}),
+        OverrideCase{"u", "abc", "--u = abc: expected comma-separated numbers"},
+        OverrideCase{"u", "nan", "--u = nan: simulation.u[0] = nan: must be finite"},
+        // [model] x0 and p (issue 13, 3).
+        OverrideCase{"x0", "1, 2",
+                     "--x0 = 1, 2: wrong length (expected 1 number, one per state in model.x, "
+                     "got 2)"},
+        OverrideCase{"x0", "inf", "--x0 = inf: model.x0[0] = inf: must be finite"},
+        OverrideCase{"model.x0", "one", "--model.x0 = one: expected comma-separated numbers"},
+        OverrideCase{"p", "k=1",
+                     "--p k=1: unknown parameter 'k' (the model has no parameters: model.p is "
+                     "empty)"},
+        OverrideCase{"model.F", "1",
+                     "--model.F = 1: unknown option 'F' (model.F can only be set in the file; "
+                     "the [model] overrides are x0 and p)"},
+        OverrideCase{"c", "x", "--c = x: unknown option 'c' (model.c can only be set in the file"},
+        OverrideCase{"model.x0s", "1",
+                     "--model.x0s = 1: unknown option 'x0s' (did you mean 'x0'?)"},
+        // Keys by meaning (issue 13, 4): the OCP's name, nosnoc's names.
+        OverrideCase{"T", "2", "--T = 2: unknown option 'T' (did you mean 'T_sim'?)"},
+        OverrideCase{"u_guess", "1", "--u_guess = 1: unknown option 'u_guess' (did you mean 'u'?)"},
+        OverrideCase{"terminal_time", "2",
+                     "--terminal_time = 2: unknown option 'terminal_time' (did you mean 'T_sim'?)"},
+        OverrideCase{"Nfe_list", "2",
+                     "--Nfe_list = 2: unknown option 'Nfe_list' (did you mean "
+                     "'N_finite_elements'?)"},
+        OverrideCase{"max_iter_homotopy", "5",
+                     "--max_iter_homotopy = 5: unknown option 'max_iter_homotopy' (did you mean "
+                     "'N_homotopy'?)"}),
     [](const ::testing::TestParamInfo<OverrideCase>& param_info) {
       return "case" + std::to_string(param_info.index);
     });

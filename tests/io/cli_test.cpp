@@ -23,6 +23,7 @@ namespace fs = std::filesystem;
 
 const std::string kOscillator = FESD_SOURCE_DIR "/examples/oscillator.toml";
 const std::string kSensitivity = FESD_SOURCE_DIR "/examples/ocp_sensitivity.toml";
+const std::string kSlidingOcp = FESD_SOURCE_DIR "/examples/ocp_sliding_mode.toml";
 
 using fesd::testing::TempDir;
 
@@ -213,6 +214,45 @@ TEST(Cli, HelpGroupsOverridesByTable) {
   EXPECT_TRUE(contains(r.out, "--n_s INT")) << r.out;
   EXPECT_TRUE(contains(r.out, "1..9")) << r.out;
   EXPECT_TRUE(contains(r.out, "--ipopt.NAME VALUE")) << r.out;
+  // [model] x0 and p (issue 13, 3), for every command; u and u_guess as lists.
+  for (const char* command : {"simulate", "solve", "check"}) {
+    const CliRun h = run_cli({command, "--help"});
+    EXPECT_TRUE(contains(h.out, "Overrides [model]")) << command;
+    EXPECT_TRUE(contains(h.out, "--x0 V1,V2,...")) << command;
+    EXPECT_TRUE(contains(h.out, "--p NAME=VALUE")) << command;
+  }
+  EXPECT_TRUE(contains(r.out, "--u V1,V2,...")) << r.out;
+  EXPECT_TRUE(contains(run_cli({"solve", "--help"}).out, "--u_guess V1,V2,..."));
+}
+
+// Parameters, x0, u and u_guess from the command line reach the problem (issue 13, 3): the
+// header of `check` shows them; bad values are one-line errors naming the option.
+TEST(Cli, ModelOverrides) {
+  const CliRun r = run_cli({"check", kOscillator, "--p", "omega=3", "--x0", "-1,2", "--model.p",
+                            "omega=4", "--p=omega=5"});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(contains(r.out, "x0          [-1, 2]")) << r.out;
+  EXPECT_TRUE(contains(r.out, "p           omega = 5")) << r.out;
+  const CliRun ocp = run_cli({"check", kSlidingOcp, "--u_guess", "0.5,-0.5", "--x0=1,2,0,0"});
+  EXPECT_EQ(ocp.code, 0) << ocp.err;
+  EXPECT_TRUE(contains(ocp.out, "u guess     u1 = 0.5, u2 = -0.5")) << ocp.out;
+  EXPECT_TRUE(contains(ocp.out, "x0          [1, 2, 0, 0]")) << ocp.out;
+  for (const auto& [args, message] : std::vector<std::pair<std::vector<std::string>, std::string>>{
+           {{"--p", "omgea=3"}, "--p omgea=3: unknown parameter 'omgea' (did you mean 'omega'?)"},
+           {{"--omega", "3"}, "('omega' is a parameter of model.p: write --p omega=3)"},
+           {{"--x0", "1"},
+            "--x0 = 1: wrong length (expected 2 numbers, one per state in model.x, "
+            "got 1)"},
+           {{"--T", "2"}, "--T = 2: unknown option 'T' (did you mean 'T_sim'?)"},
+           {{"--u_guess", "0"}, "unknown option 'u_guess' (did you mean 'u'?)"}}) {
+    std::vector<std::string> argv{"simulate", kOscillator};
+    argv.insert(argv.end(), args.begin(), args.end());
+    const CliRun bad = run_cli(argv);
+    EXPECT_EQ(bad.code, 2) << bad.err;
+    EXPECT_EQ(bad.err.rfind("fesd: error: " + args.front(), 0), 0U) << bad.err;
+    EXPECT_TRUE(contains(bad.err, message)) << bad.err;
+    EXPECT_EQ(bad.err_lines(), 1) << bad.err;
+  }
 }
 
 TEST(Cli, BadPlotExtensionExits2BeforeSolving) {
@@ -455,6 +495,147 @@ TEST(CliRobust, ConstantToThePowerZeroChecks) {
   const CliRun r = run_cli({"check", file});
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(contains(r.out, "is valid")) << r.out;
+}
+
+// ---- the documented command lines (issue 13, 3) ----------------------------------------------
+// Every command-line example in README.md and docs/problem-files.md, read from the docs
+// themselves: the code spans `--...` and `fesd ...`, and README's shell blocks.
+
+/// The code spans of a Markdown text (`a`, ``a``), whitespace runs as one space, "\|" as "|".
+std::vector<std::string> code_spans(const std::string& text) {
+  std::vector<std::string> spans;
+  std::size_t i = 0;
+  while ((i = text.find('`', i)) != std::string::npos) {
+    std::size_t n = 0;
+    while (i + n < text.size() && text[i + n] == '`') ++n;
+    const std::string fence(n, '`');
+    std::size_t end = text.find(fence, i + n);
+    while (end != std::string::npos && end + n < text.size() && text[end + n] == '`')
+      end = text.find(fence, end + n + 1);
+    if (end == std::string::npos) break;
+    std::string span;
+    for (std::size_t k = i + n; k < end; ++k) {
+      const char ch = text[k] == '\n' ? ' ' : text[k];
+      if (ch == ' ' && (span.empty() || span.back() == ' ')) continue;
+      if (ch == '|' && !span.empty() && span.back() == '\\') span.pop_back();
+      span += ch;
+    }
+    while (!span.empty() && span.back() == ' ') span.pop_back();
+    if (n < 3) spans.push_back(span);  // not a fenced block
+    i = end + n;
+  }
+  return spans;
+}
+
+std::vector<std::string> words(const std::string& s) {
+  std::vector<std::string> out;
+  std::size_t i = 0;
+  while (i < s.size()) {
+    const std::size_t j = std::min(s.find(' ', i), s.size());
+    if (j > i) out.push_back(s.substr(i, j - i));
+    i = j + 1;
+  }
+  return out;
+}
+
+/// Placeholders (`--KEY VALUE`, `fesd simulate FILE`) and elisions are forms, not examples.
+bool is_template(const std::string& span) {
+  for (const char* p : {"KEY", "VALUE", "NAME", "TABLE", "FILE", "OUT", "...", "V1"})
+    if (contains(span, p)) return true;
+  return false;
+}
+
+/// Checks one span of `doc`; returns "" or what is wrong.
+std::string check_span(const std::string& span) {
+  const std::vector<std::string> files{kOscillator, kSlidingOcp};
+  if (span.rfind("fesd ", 0) == 0) {
+    std::vector<std::string> args = words(span.substr(5));
+    const bool has_option = std::any_of(args.begin(), args.end(),
+                                        [](const std::string& w) { return w.rfind('-', 0) == 0; });
+    if (!has_option || is_template(span)) return "";  // `fesd solve`: a name, not a command
+    const CliRun r = run_cli(args);
+    return r.code == 0 ? "" : "exit " + std::to_string(r.code) + ": " + r.err;
+  }
+  if (span.rfind("--", 0) != 0) return "";
+  if (const std::size_t colon = span.find(": "); colon != std::string::npos) {
+    // A message: run its head ("--n_s = 0", "--p omega=nan") and find its text in stderr, the
+    // parts around "(...)" each.
+    const std::string head = span.substr(2, colon - 2);
+    const std::size_t eq = head.find(" = ");
+    const std::size_t sp = head.find(' ');
+    const std::vector<std::string> option =
+        eq != std::string::npos
+            ? std::vector<std::string>{"--" + head.substr(0, eq), head.substr(eq + 3)}
+            : std::vector<std::string>{"--" + head.substr(0, sp), head.substr(sp + 1)};
+    std::string errors;
+    for (const std::string& file : files) {
+      std::vector<std::string> args{"check", file};
+      args.insert(args.end(), option.begin(), option.end());
+      const CliRun r = run_cli(args);
+      bool found = r.code == 2;
+      for (std::size_t from = 0; found && from < span.size();) {
+        const std::size_t to = std::min(span.find("(...)", from), span.size());
+        found = contains(r.err, span.substr(from, to - from));
+        from = to + 5;
+      }
+      if (found) return "";
+      errors += r.err;
+    }
+    return "message not produced; got: " + errors;
+  }
+  if (is_template(span)) return "";
+  if (span.find(' ') == std::string::npos && span.find('=') == std::string::npos) {
+    // A key named in the text: an option of some command.
+    for (const char* command : {"simulate", "solve"})
+      if (contains(run_cli({command, "--help"}).out, span + " ")) return "";
+    return "not in fesd simulate --help or fesd solve --help";
+  }
+  std::string errors;
+  for (const std::string& file : files) {  // an example: valid for one of the example files
+    std::vector<std::string> args{"check", file};
+    for (const std::string& w : words(span)) args.push_back(w);
+    const CliRun r = run_cli(args);
+    if (r.code == 0) return "";
+    errors += r.err;
+  }
+  return errors;
+}
+
+TEST(CliDocs, EveryCommandLineSpanRunsAsDocumented) {
+  int checked = 0;
+  for (const char* doc : {"README.md", "docs/problem-files.md"}) {
+    for (const std::string& span : code_spans(read_file(FESD_SOURCE_DIR "/" + std::string(doc)))) {
+      if (span.rfind("--", 0) != 0 && span.rfind("fesd ", 0) != 0) continue;
+      ++checked;
+      EXPECT_EQ(check_span(span), "") << doc << ": `" << span << "`";
+    }
+  }
+  EXPECT_GE(checked, 30);  // the parser found the spans
+}
+
+// REAL SOLVES (the README's commands, a few seconds each): run as written, from a scratch
+// directory (the outputs land there).
+TEST(CliDocs, ReadmeCommandsRun) {
+  if (run_shell("command -v gnuplot >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "gnuplot is not installed (the README's commands write plots)";
+  const std::string readme = read_file(FESD_SOURCE_DIR "/README.md");
+  TempDir dir;
+  int run = 0;
+  std::size_t at = 0;
+  while ((at = readme.find("./build/fesd ", at)) != std::string::npos) {
+    const std::size_t end = readme.find('\n', at);
+    std::string args = readme.substr(at + 13, end - at - 13);
+    at = end;
+    const std::string source = FESD_SOURCE_DIR "/";
+    for (std::size_t k = 0; (k = args.find("examples/", k)) != std::string::npos;
+         k += source.size() + 9)
+      args.insert(k, source);
+    const std::string cmd = "cd " + shell_quote(dir.file("")) + " && " + shell_quote(FESD_CLI) +
+                            " " + args + " >out.txt 2>err.txt";
+    EXPECT_EQ(run_shell(cmd), 0) << args << "\n" << read_file(dir.file("err.txt"));
+    ++run;
+  }
+  EXPECT_EQ(run, 3);
 }
 
 }  // namespace

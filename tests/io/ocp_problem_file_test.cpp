@@ -445,8 +445,23 @@ TEST(OcpProblemFileOverride, BadOverridesThrowAndChangeNothing) {
   expect_message("T", "inf", "--T = inf: must be finite");
   expect_message("N_stage", "2",
                  "--N_stage = 2: unknown option 'N_stage' (did you mean 'N_stages'");
-  expect_message("T_sim", "2", "--T_sim = 2: unknown option 'T_sim'");
-  expect_message("lbx", "1", "expressions, bounds and guesses can only be set in the file");
+  expect_message("T_sim", "2", "--T_sim = 2: unknown option 'T_sim' (did you mean 'T'?)");
+  expect_message("N_sim", "2", "--N_sim = 2: unknown option 'N_sim' (did you mean 'N_stages'?)");
+  expect_message("u", "1", "--u = 1: unknown option 'u' (did you mean 'u_guess'?)");
+  expect_message("lbx", "1",
+                 "--lbx = 1: unknown option 'lbx' (expressions and bounds can only be "
+                 "set in the file)");
+  expect_message("u_guess", "1, 2",
+                 "--u_guess = 1, 2: wrong length (expected 1 number, one per control in model.u, "
+                 "got 2)");
+  expect_message("u_guess", "nan", "--u_guess = nan: ocp.u_guess[0] = nan: must be finite");
+  expect_message("x0", "1",
+                 "--x0 = 1: wrong length (expected 2 numbers, one per state in "
+                 "model.x, got 1)");
+  expect_message("p", "zz=1", "--p zz=1: unknown parameter 'zz' (parameters in model.p: a)");
+  expect_message("a", "1",
+                 "--a = 1: unknown option 'a' ('a' is a parameter of model.p: write "
+                 "--p a=1)");
   expect_message("initialization", "zero", "unknown name (expected one of constant, simulation");
   expect_message("relax_terminal_constraint", "ell_1", "there are no terminal constraints");
   expect_message("simulation.T_sim", "1", "--simulation.T_sim = 1: unknown table 'simulation'");
@@ -455,7 +470,27 @@ TEST(OcpProblemFileOverride, BadOverridesThrowAndChangeNothing) {
   EXPECT_EQ(q.ocp.T, fresh.ocp.T);
   EXPECT_EQ(q.ocp.N_stages, fresh.ocp.N_stages);
   EXPECT_EQ(q.ocp.terminal_constraint, fresh.ocp.terminal_constraint);
+  EXPECT_EQ(q.ocp.x0, fresh.ocp.x0);
+  EXPECT_EQ(q.ocp.p, fresh.ocp.p);
+  EXPECT_EQ(q.ocp.u_guess, fresh.ocp.u_guess);
   expect_same_options(q.options, fresh.options);
+}
+
+// [model] x0 and p, [ocp] u_guess (issue 13, 3), checked with the file's rules (bounds).
+TEST(OcpProblemFileOverride, InitialStateParametersAndControlGuess) {
+  OcpProblem q = parse_ocp_problem(std::string(kSmall) + "lbu = [-1]\nubu = [1]\n", "g.toml");
+  apply_override(q, "x0", "1.5, -2");
+  apply_override(q, "p", "a=-4");
+  apply_override(q, "ocp.u_guess", "0.25");
+  EXPECT_EQ(q.ocp.x0, (Eigen::VectorXd(2) << 1.5, -2.0).finished());
+  EXPECT_EQ(q.ocp.p, (Eigen::VectorXd(1) << -4.0).finished());
+  EXPECT_EQ(q.ocp.model.p_default, (Eigen::VectorXd(1) << -4.0).finished());
+  EXPECT_EQ(q.ocp.u_guess, (Eigen::VectorXd(1) << 0.25).finished());
+  const std::string m = outcome_message([&] { apply_override(q, "u_guess", "3"); });
+  EXPECT_NE(m.find("--u_guess = 3: ocp.u_guess[0]: 3 is outside [lbu, ubu] = [-1, 1]"),
+            std::string::npos)
+      << m;
+  EXPECT_EQ(q.ocp.u_guess, (Eigen::VectorXd(1) << 0.25).finished());
 }
 
 }  // namespace

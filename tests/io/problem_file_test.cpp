@@ -587,5 +587,25 @@ T_sim = 1
   expect_vector_near(c.u, {0.5, -2.0});
 }
 
+// [model] x0 and p (issue 13, 3): the states of model.x only (a clock keeps t0), one parameter
+// per override, stored as the problem's p and the model's p_default.
+TEST(ProblemFileOverride, InitialStateAndParameters) {
+  SimulationProblem q = load_example("leaving_sliding.toml");
+  apply_override(q, "t0", "1.5");
+  apply_override(q, "x0", "-0.25");
+  expect_vector_near(q.x0, {-0.25, 1.5});
+  apply_override(q, "model.x0", " 2 ");
+  expect_vector_near(q.x0, {2.0, 1.5});
+
+  SimulationProblem o = load_example("oscillator.toml");
+  apply_override(o, "--x0", "1, -2");
+  expect_vector_near(o.x0, {1.0, -2.0});
+  apply_override(o, "p", "omega=3.5");
+  expect_vector_near(o.p, {3.5});
+  expect_vector_near(o.model.p_default, {3.5});
+  apply_override(o, "model.p", " omega = -1e-3 ");
+  expect_vector_near(o.p, {-1e-3});
+}
+
 }  // namespace
 }  // namespace fesd

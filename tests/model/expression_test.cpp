@@ -449,6 +449,25 @@ TEST(Expression, FunctionErrors) {
   EXPECT_ERROR("2*pi(x1)", "'pi' is a constant, not a function");
 }
 
+// Issue 13, 4: a nonsmooth function points to the region form (not "did you mean 'sin'?").
+TEST(Expression, NonsmoothFunctionsPointToRegions) {
+  EXPECT_EQ(
+      error_of("x2 - sign(x1)"),
+      "test.toml: model.F[0]: 'sign' in 'x2 - sign(x1)': nonsmooth functions (sign, min, max, "
+      "heaviside, step, ...) are not part of the expression language; write the switch as "
+      "regions, with switching functions c, a sign matrix S and one vector field per region "
+      "in F (one state: x' = -sign(x) is c = [\"x\"], F = [[\"-1\"], [\"1\"]]; "
+      "docs/problem-files.md, \"Nonsmooth functions: regions\"). nosnoc's Heaviside step "
+      "reformulation is a discretization option of nosnoc, not a function in expressions");
+  for (const char* e : {"min(x1, x2)", "max(x1, 0)", "heaviside(x1)", "step(x1)", "Sign(x1)",
+                        "sgn(x1)", "fmax(x1, 1)", "if_else(x1, 1, 2)", "floor(x1)"})
+    EXPECT_ERROR(e, "nonsmooth functions (sign, min, max, heaviside, step, ...)");
+  // abs stays a function (docs/problem-files.md, "Nonsmooth functions: regions"); a symbol named
+  // max is called as a symbol is.
+  EXPECT_EQ(error_of("abs(x1)"), "<no error>");
+  EXPECT_EQ(error_of("2*max", {"max"}), "<no error>");
+}
+
 TEST(Expression, NonFiniteConstants) {
   EXPECT_ERROR("1e999*x1", "number '1e999' is too large (not a finite double) in '1e999*x1'");
   EXPECT_ERROR("x1 + 999999999e300", "number '999999999e300' is too large");
