@@ -15,8 +15,12 @@ namespace fesd {
 void write_json(const IntegratorResult& result, const Pss& model, const std::string& path);
 /// CSV: header "t,<state names>", one row per element boundary. Throws fesd::IoError.
 void write_csv(const IntegratorResult& result, const Pss& model, const std::string& path);
-/// PNG or SVG (by extension) with gnuplot: states over time with switching times marked, and
-/// the step sizes h_n. Throws fesd::IoError (also if gnuplot is missing or the extension unknown).
+/// PNG or SVG (by extension) with gnuplot: the states over time with every switch dashed and
+/// labelled with the regions active before and after it ("{0}->{0,1}"), and the step sizes h_n
+/// (as h_n / h_ref - 1 when they agree to 4 digits); elements where a subsystem has two or more
+/// active regions (sliding) are shaded. A two-state model (no clock) gets a phase portrait with
+/// the switching surfaces c(x) = 0 (or g_i = g_j), evaluated with model.p_default. Throws
+/// fesd::IoError (also if gnuplot is missing or the extension unknown).
 void write_plot(const IntegratorResult& result, const Pss& model, const std::string& path,
                 const std::string& title = "");
 
@@ -33,10 +37,13 @@ void write_json(const OcpResult& result, const Pss& model, const std::string& pa
 /// has the control of the interval it belongs to (the interval of the element starting there; the
 /// last row: the last interval). Throws fesd::IoError.
 void write_csv(const OcpResult& result, const Pss& model, const std::string& path);
-/// PNG or SVG with gnuplot, four panels over time: the states (switching times dashed), the
-/// controls as steps on the control grid, the step sizes h_n (control-interval boundaries dotted,
-/// nominal T_k / N_FE and the smallest and largest h_n dashed), and the switching indicator eta_n
-/// of (31) on a log scale (zeros, i.e. switches, marked at the bottom). Throws fesd::IoError.
+/// PNG or SVG with gnuplot, four panels over time: the states (switches dashed and labelled with
+/// the regions before and after), the controls as steps on the control grid, the step sizes h_n
+/// (control-interval boundaries dotted, nominal T_k / N_FE and the smallest and largest h_n
+/// dashed; relative to h_ref when they agree to 4 digits), and the switching indicator eta_n of
+/// (31) on a log scale with a caption (zeros, i.e. switches, marked at the bottom); sliding
+/// elements shaded, and a phase portrait for two states as for simulations. Throws
+/// fesd::IoError.
 void write_plot(const OcpResult& result, const Pss& model, const std::string& path,
                 const std::string& title = "");
 

@@ -48,6 +48,7 @@
 #include "fesd/problem_file.hpp"
 #include "fesd/status.hpp"
 #include "fesd/tableau.hpp"
+#include "io/describe.hpp"
 
 #ifndef FESD_VERSION
 #define FESD_VERSION "0.1.0"
@@ -498,10 +499,15 @@ struct SolveArgs {
 
 int run_check(const std::string& file, const Overrides& overrides) {
   check_input_file(file);
+  // The header, then the model as read: every region's sign pattern and vector field.
   if (fesd::problem_file_kind(file) == fesd::ProblemKind::Ocp) {
-    print_header(load<fesd::OcpProblem>(file, overrides));
+    const auto problem = load<fesd::OcpProblem>(file, overrides);
+    print_header(problem);
+    out::print("{}", fesd::io_detail::describe(problem));
   } else {
-    print_header(load<fesd::SimulationProblem>(file, overrides));
+    const auto problem = load<fesd::SimulationProblem>(file, overrides);
+    print_header(problem);
+    out::print("{}", fesd::io_detail::describe(problem));
   }
   out::print("check: '{}' is valid (nothing was solved)\n", file);
   return kExitSolved;

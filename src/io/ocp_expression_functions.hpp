@@ -36,6 +36,8 @@ class ExpressionOcpFunctions final : public OcpFunctions {
   bool has_f_q_T() const override { return e_.f_q_T.has_value(); }
   int n_g_path() const { return static_cast<int>(e_.g_path.size()); }
   int n_g_terminal() const { return static_cast<int>(e_.g_terminal.size()); }
+  /// The parsed expressions (text() is the source), for descriptions of the problem.
+  const OcpExpressions& expressions() const { return e_; }
 
 #define FESD_DECLARE_EXPRESSION_OCP_FUNCTIONS(T)                          \
   T f_q(const T* x, const T* u, const T* p) const override;               \

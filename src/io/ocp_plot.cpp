@@ -1,15 +1,21 @@
 // src/io/ocp_plot.cpp: plots of an OCP solution with gnuplot (PNG or SVG), in the spirit of the
-// paper's Figs. 10-12. gnuplot.hpp runs the script; the data go inline.
+// paper's Figs. 10-12. gnuplot.hpp runs the script; the data go inline; the parts shared with the
+// integrator plot are in plot_parts.hpp.
 //
-// Layout, all panels over time t in [0, T] with the switching times as dashed vertical lines:
+// Layout, all panels over time t in [0, T] with the switches as dashed vertical lines (labelled
+// in the top panel with the regions active before and after, "{0,2}->{0,2,3}") and the elements
+// where a subsystem has two or more active regions (sliding) shaded:
 //   1. the states x(t) at the finite-element boundaries;
 //   2. the controls, piecewise constant on the control grid (drawn as steps; left out if n_u = 0);
 //   3. the step sizes h_n as a step function over [t_n, t_{n+1}], with the control-interval
 //      boundaries as dotted vertical lines and, as dashed horizontal lines, the nominal step
-//      T_k / N_FE of each interval and the smallest and largest h_n (Fig. 12);
-//   4. the switching indicator eta_n of (31) at the interior element boundaries, on a log scale;
-//      eta_n = 0 marks a switch and cannot be drawn on a log scale, so such points are marked at
-//      the bottom of the panel.
+//      T_k / N_FE of each interval and the smallest and largest h_n (Fig. 12); h_n / h_ref - 1
+//      when all h_n agree to 4 digits;
+//   4. the switching indicator eta_n of (31) at the interior element boundaries, on a log scale,
+//      with a caption: eta_n = 0 marks a switch (and cannot be drawn on a log scale, so such
+//      points are marked at the bottom of the panel), eta_n > 0 is where step equilibration
+//      holds h_n = h_{n-1}.
+// A two-state system gets a phase portrait on the right: x2 over x1 with the switching surfaces.
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -18,6 +24,7 @@
 #include "fesd/error.hpp"
 #include "fesd/io.hpp"
 #include "io/gnuplot.hpp"
+#include "io/plot_parts.hpp"
 
 namespace fesd {
 namespace {
@@ -27,13 +34,14 @@ using io_detail::gp_string;
 using io_detail::names_or_default;
 
 struct Panel {
-  double origin = 0, height = 0;
+  double origin = 0, height = 0, width = 1;
 };
 
 /// Sets origin and size of a panel and its vertical margins (character units).
 std::string place(const Panel& p, double tmargin, double bmargin) {
-  return "set origin 0," + gp_number(p.origin) + "\nset size 1," + gp_number(p.height) +
-         "\nset tmargin " + gp_number(tmargin) + "\nset bmargin " + gp_number(bmargin) + "\n";
+  return "set origin 0," + gp_number(p.origin) + "\nset size " + gp_number(p.width) + "," +
+         gp_number(p.height) + "\nset tmargin " + gp_number(tmargin) + "\nset bmargin " +
+         gp_number(bmargin) + "\n";
 }
 
 /// A y range with 10 % padding around [lo, hi] (a unit band if the data are flat or missing).
@@ -45,7 +53,7 @@ std::string padded_yrange(double lo, double hi) {
 }
 
 std::string make_script(const OcpResult& r, const Pss& model, const std::string& path,
-                        const std::string& title, const std::string& terminal) {
+                        const std::string& title) {
   const std::size_t n_points = std::min(r.t.size(), r.x.size());
   const std::size_t n_x = static_cast<std::size_t>(r.x[0].size());
   const std::size_t n_u = r.u.empty() ? 0 : static_cast<std::size_t>(r.u[0].size());
@@ -53,8 +61,11 @@ std::string make_script(const OcpResult& r, const Pss& model, const std::string&
   const std::vector<std::string> u_names = names_or_default(model.control_names, n_u, "u");
   const double t0 = r.t.front(), t_end = r.t[n_points - 1];
   const std::size_t n_h = std::min({r.h.size(), n_points - 1});
+  const bool portrait = io_detail::wants_phase_portrait(model, static_cast<int>(n_x));
+  const int width_px = portrait ? 1500 : 1000;
+  const double left = portrait ? 0.64 : 1.0;  // width of the time panels (screen fraction)
 
-  std::string s = terminal;
+  std::string s = io_detail::terminal_for(path, width_px, 1000);
   s += "set output " + gp_string(path) + "\n";
   s += "set encoding utf8\n";
 
@@ -158,7 +169,7 @@ std::string make_script(const OcpResult& r, const Pss& model, const std::string&
   for (double w : weights) {
     const double height = top * w / total;
     y -= height;
-    panels.push_back({std::max(0.0, y), height});
+    panels.push_back({std::max(0.0, y), height, left});
   }
   std::size_t next = 0;
 
@@ -168,24 +179,20 @@ std::string make_script(const OcpResult& r, const Pss& model, const std::string&
   s += "set grid\nset key outside right top noenhanced\n";
   if (t_end > t0) s += "set xrange [" + gp_number(t0) + ":" + gp_number(t_end) + "]\n";
 
-  // The switching times: dashed lines in every panel, labelled in the top one.
-  int tag = 1;
-  const bool label_switches = r.switches.size() <= 20;
-  for (const SwitchEvent& e : r.switches) {
-    if (!std::isfinite(e.t)) continue;
-    s += "set arrow " + std::to_string(tag) + " from " + gp_number(e.t) + ", graph 0 to " +
-         gp_number(e.t) + ", graph 1 nohead dashtype 2 linewidth 1 linecolor rgb '#707070' back\n";
-    if (label_switches)
-      s += "set label " + std::to_string(tag) + " 't_s' at " + gp_number(e.t) +
-           ", graph 1 offset 0,0.6 center textcolor rgb '#505050'\n";
-    ++tag;
-  }
+  // Sliding elements shaded and the switches dashed in every panel, labelled in the top one.
+  const auto sliding = io_detail::sliding_intervals(model, r.t, r.active_set);
+  s += io_detail::shade_intervals(sliding);
+  int tag = 1, label_rows = 0;
+  s +=
+      io_detail::switch_markup(r.switches, t0, t_end, width_px * left - 34 * 8, 1, tag, label_rows);
   const std::string switch_key =
-      r.switches.empty() ? "NaN notitle"
-                         : "NaN with lines dashtype 2 linecolor rgb '#707070' title 'switches'";
+      (r.switches.empty()
+           ? std::string("NaN notitle")
+           : std::string("NaN with lines dashtype 2 linecolor rgb '#707070' title 'switches'")) +
+      (sliding.empty() ? "" : io_detail::sliding_key_entry());
 
   // 1. states.
-  s += place(panels[next++], 2, 0.5);
+  s += place(panels[next++], std::max(2.0, 1.0 + 1.2 * label_rows), 0.5);
   s += "set format x ''\nunset xlabel\nset ylabel 'x(t)'\nset offsets 0, 0, graph 0.05, graph "
        "0.05\n";
   s += "plot ";
@@ -215,16 +222,23 @@ std::string make_script(const OcpResult& r, const Pss& model, const std::string&
 
   // 3. step sizes.
   s += place(panels[next++], 0.5, 0.5);
-  s += "set ylabel 'h_n' enhanced\n";
+  // On the relative scale (all h_n and nominal steps agree to 4 digits) every curve is
+  // h / h_ref - 1.
+  const io_detail::StepAxis axis =
+      io_detail::step_axis(std::min(h_min, nom_min), std::max(h_max, nom_max));
+  s += io_detail::step_ylabel(axis) + io_detail::step_reference_label(axis, 0.2);
   if (n_h == 0 || !(h_max >= h_min)) {
     s += "set yrange [0:1]\nplot NaN notitle\n";
   } else {
-    s += padded_yrange(std::min(h_min, nom_min), std::max(h_max, nom_max));
-    s += "plot $steps using 1:2 with steps linewidth 2 linecolor rgb '#1f77b4' title 'h_n', "
-         "$steps using 1:3 with steps dashtype 2 linewidth 1 linecolor rgb '#000000' "
-         "title 'nominal', " +
-         gp_number(h_min) + " with lines dashtype 2 linecolor rgb '#d62728' title 'min h_n', " +
-         gp_number(h_max) + " with lines dashtype 2 linecolor rgb '#ff7f0e' title 'max h_n'" +
+    s += padded_yrange(axis.value(std::min(h_min, nom_min)), axis.value(std::max(h_max, nom_max)));
+    s += "plot $steps using 1:" + io_detail::step_column(axis, 2) +
+         " with steps linewidth 2 linecolor rgb '#1f77b4' title 'h_n', $steps using 1:" +
+         io_detail::step_column(axis, 3) +
+         " with steps dashtype 2 linewidth 1 linecolor rgb '#000000' title 'nominal', " +
+         gp_number(axis.value(h_min)) +
+         " with lines dashtype 2 linecolor rgb '#d62728' title 'min h_n', " +
+         gp_number(axis.value(h_max)) +
+         " with lines dashtype 2 linecolor rgb '#ff7f0e' title 'max h_n'" +
          (r.t_ctrl.size() > 2
               ? ", NaN with lines dashtype 3 linecolor rgb '#2ca02c' title 'control grid'\n"
               : "\n");
@@ -232,7 +246,11 @@ std::string make_script(const OcpResult& r, const Pss& model, const std::string&
 
   // 4. switching indicator.
   s += place(panels[next++], 0.5, 3.5);
-  s += "set format x\nset xlabel 't'\nset ylabel 'eta_n' enhanced\n";
+  s += "unset label\nset format x\nset xlabel 't'\nset ylabel 'eta_n' enhanced\n";
+  // The caption, in the right margin below the key.
+  s += "set label 1 \"switching indicator (31)\\neta_n = 0: active set\\nchanges at t_n (switch)"
+       "\\neta_n > 0: step\\nequilibration holds\\nh_n = h_{n-1}\" at graph 1.03, graph 0.66 left "
+       "noenhanced font ',9' textcolor rgb '#404040'\n";
   if (eta_max >= eta_min) {
     // The zero markers sit a decade below the smallest positive eta.
     const double floor_value = eta_min / 10;
@@ -251,18 +269,27 @@ std::string make_script(const OcpResult& r, const Pss& model, const std::string&
   } else {
     s += "set yrange [0:1]\nplot NaN notitle\n";
   }
+  if (portrait) {
+    s += io_detail::phase_portrait(model, io_detail::phase_data(r, model), left, 0, 1 - left, top,
+                                   width_px, 1000);
+  }
   s += "unset multiplot\nunset output\n";
   return s;
 }
 
 }  // namespace
 
+std::string io_detail::plot_script(const OcpResult& r, const Pss& model, const std::string& path,
+                                   const std::string& title) {
+  return make_script(r, model, path, title);
+}
+
 void write_plot(const OcpResult& result, const Pss& model, const std::string& path,
                 const std::string& title) {
-  const std::string terminal = io_detail::terminal_for(path, 1000, 1000);
+  io_detail::terminal_for(path, 1000, 1000);  // the extension is checked first
   if (std::min(result.t.size(), result.x.size()) == 0)
     throw IoError("cannot plot to '" + path + "': the result has no time points");
-  io_detail::run_plot_script(path, make_script(result, model, path, title, terminal));
+  io_detail::run_plot_script(path, make_script(result, model, path, title));
 }
 
 }  // namespace fesd

@@ -46,6 +46,11 @@ class ExpressionModel final : public PssFunctions {
 
   const ExpressionLayout& layout() const { return layout_; }
   int n_regions() const { return static_cast<int>(fields_.size()); }
+  /// The parsed expressions, in Pss order (text() is the source): c and g of all subsystems
+  /// concatenated, one vector field per region. For descriptions of the model (`fesd check`).
+  const std::vector<expr::Expression>& c_expressions() const { return c_; }
+  const std::vector<expr::Expression>& g_expressions() const { return g_; }
+  const std::vector<std::vector<expr::Expression>>& fields() const { return fields_; }
 
 #define FESD_DECLARE_EXPRESSION_FUNCTIONS(T)               \
   void c(const T* x, const T* p, T* c_out) const override; \

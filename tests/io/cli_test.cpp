@@ -151,6 +151,109 @@ TEST(Cli, CheckExample) {
   EXPECT_TRUE(r.err.empty()) << r.err;
 }
 
+// Issue 13, 5: check prints the model it understood, region by region: the row of S and the row
+// of F, so that a transposed F (nosnoc's layout) stands out.
+TEST(Cli, CheckPrintsTheRegionsOfTheOscillator) {
+  const CliRun r = run_cli({"check", kOscillator});
+  EXPECT_EQ(r.code, 0) << r.err;
+  for (const char* line : {
+           "  p           omega = 6.28319\n",
+           "  fesd        gamma_h = 1, rho_h = 1, stage_lambda_sign = auto, pin_sliding_exits = "
+           "1\n",
+           "\nmodel as read (region i: row i of S and of F)\n"
+           "  c[0]        x1^2 + x2^2 - 1\n"
+           "  region 0    c[0] < 0:  x1' = x1 + omega*x2,  x2' = -omega*x1 + x2\n"
+           "  region 1    c[0] > 0:  x1' = x1 - omega*x2,  x2' = omega*x1 + x2\n"
+           "  hint        F has one row per region (F[i] = the 2 components of region i's field); "
+           "nosnoc's F has\n"
+           "              one column per region. With n_x = 2 = the number of regions, a "
+           "transposed F passes\n"
+           "              every check: compare the fields above with the sign patterns.\n"
+           "check: '",
+       }) {
+    EXPECT_TRUE(contains(r.out, line)) << "missing:\n" << line << "\nin:\n" << r.out;
+  }
+}
+
+TEST(Cli, CheckPrintsSubsystemsControlsAndIndicatorFunctions) {
+  TempDir dir;
+  const std::string file = dir.file("two.toml");
+  std::ofstream(file) << R"([model]
+x = ["x1", "x2", "x3"]
+u = ["w"]
+p = { a = 0.5 }
+x0 = [1, -2, 0]
+[[model.subsystem]]
+c = ["x1", "x2 - a"]
+S = [[1, 1], [-1, 1], [-1, -1]]
+F = [["-1", "0", "w"], ["1", "0", "0"], ["2", "0", "a*x3"]]
+[[model.subsystem]]
+g = ["-x2", "x2", "0"]
+F = [["0", "-1", "0"], ["0", "1", "0"], ["0", "0", "0"]]
+[simulation]
+T_sim = 2
+u = [0.25]
+)";
+  const CliRun r = run_cli({"check", file});
+  EXPECT_EQ(r.code, 0) << r.err;
+  const std::string expected =
+      "model as read (region i: row i of S and of F)\n"
+      "  controls    w\n"
+      "  subsystem 0 regions 0..2, 2 switching functions\n"
+      "  c[0]        x1\n"
+      "  c[1]        x2 - a\n"
+      "  region 0    c[0] > 0, c[1] > 0:  x1' = -1,  x2' = 0,  x3' = w\n"
+      "  region 1    c[0] < 0, c[1] > 0:  x1' = 1,  x2' = 0,  x3' = 0\n"
+      "  region 2    c[0] < 0, c[1] < 0:  x1' = 2,  x2' = 0,  x3' = a*x3\n"
+      "  subsystem 1 regions 3..5, 3 indicator functions\n"
+      "  g[0]        -x2\n"
+      "  g[1]        x2\n"
+      "  g[2]        0\n"
+      "  region 3    g[0] smallest:  x1' = 0,  x2' = -1,  x3' = 0\n"
+      "  region 4    g[1] smallest:  x1' = 0,  x2' = 1,  x3' = 0\n"
+      "  region 5    g[2] smallest:  x1' = 0,  x2' = 0,  x3' = 0\n"
+      "  dynamics    x' = the sum of one active region's field per subsystem (21a), e.g. f_0 + "
+      "f_3 in\n"
+      "              regions 0 and 3\n"
+      "  hint        F has one row per region (F[i] = the 3 components of region i's field); "
+      "nosnoc's F has\n"
+      "              one column per region. With n_x = 3 = the number of regions of a subsystem, "
+      "a\n"
+      "              transposed F passes every check: compare the fields above with the sign "
+      "patterns.\n"
+      "check: '";
+  EXPECT_TRUE(contains(r.out, expected)) << "expected:\n" << expected << "\nin:\n" << r.out;
+  EXPECT_TRUE(contains(r.out, "  u           w = 0.25\n")) << r.out;
+}
+
+TEST(Cli, CheckShowsTheClockState) {
+  const CliRun r = run_cli({"check", FESD_SOURCE_DIR "/examples/leaving_sliding.toml"});
+  EXPECT_EQ(r.code, 0) << r.err;
+  const std::string expected =
+      "  clock       t' = 1 (the time t, appended to the states)\n"
+      "  c[0]        x\n"
+      "  region 0    c[0] < 0:  x' = 1 + t,  t' = 1\n"
+      "  region 1    c[0] > 0:  x' = -1 + t,  t' = 1\n"
+      "check: '";
+  EXPECT_TRUE(contains(r.out, expected)) << "expected:\n" << expected << "\nin:\n" << r.out;
+  EXPECT_FALSE(contains(r.out, "hint")) << r.out;  // one state of the user's, two regions
+}
+
+TEST(CliSolve, CheckPrintsTheOcpCostsAndNoHintWithoutAmbiguity) {
+  const CliRun r = run_cli({"check", kSensitivity});
+  EXPECT_EQ(r.code, 0) << r.err;
+  const std::string expected =
+      "  c[0]        x\n"
+      "  region 0    c[0] > 0:  x' = 1\n"
+      "  region 1    c[0] < 0:  x' = 3\n"
+      "\ncosts and constraints as read\n"
+      "  f_q         x^2\n"
+      "  f_q_T       (x - 5/3)^2\n"
+      "check: '";
+  EXPECT_TRUE(contains(r.out, expected)) << "expected:\n" << expected << "\nin:\n" << r.out;
+  EXPECT_FALSE(contains(r.out, "hint")) << r.out;  // one state: F cannot be transposed
+}
+
 TEST(Cli, BadOverrideExits2NamingTheKey) {
   ASSERT_TRUE(fs::exists(kOscillator)) << kOscillator << " is missing";
   for (const char* command : {"simulate", "check"}) {
