@@ -4,12 +4,16 @@
 //       N_FE = 6: status, objective, terminal error, complementarity residual, NLPs, IPOPT
 //       iterations, time, and the switching sequence;
 //   (b) Fig. 12 as a table: h_{k,n} and eta_n per element with step equilibration (the paper's
-//       (31) 'eta', the OCP default 'l2_relaxed', nosnoc's 'heuristic_mean') and without ('none');
+//       (31) 'eta', the OCP default 'l2_relaxed', nosnoc's 'heuristic_mean' and
+//       'heuristic_delta') and without ('none');
 //   (c) the PEERS.md row: nosnoc_py's variant of (61) (cost int v'v, q(4) = q_final exactly,
-//       heuristic_mean with rho_h = 10), to be set beside nosnoc_py's 10 NLPs, 338 iterations,
-//       objective 5.596209, 2.7-3.6 s.
+//       v' = 2u, heuristic_mean with rho_h = 10 as its example sets), to be set beside nosnoc_py's
+//       10 NLPs, 338 iterations, objective 5.596209, 2.7-3.6 s; also with nosnoc_py's default
+//       step equilibration (heuristic_delta, rho_h = 1) and with fesd's OCP default (l2_relaxed,
+//       rho_h = 1). --repeat N solves each row N times and reports the median wall time.
 //
-//   sliding_ocp [--part a|b|c|all] [--csv FILE] [--json FILE]
+//   sliding_ocp [--part a|b|c|all] [--repeat N] [--csv FILE] [--json FILE]
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -31,7 +35,7 @@ namespace fesd_bench {
 void usage(const std::string& why, int exit_code) {
   std::fprintf(stderr,
                "sliding_ocp: %s\n"
-               "usage: sliding_ocp [--part a|b|c|all] [--csv FILE] [--json FILE]\n",
+               "usage: sliding_ocp [--part a|b|c|all] [--repeat N] [--csv FILE] [--json FILE]\n",
                why.c_str());
   std::exit(exit_code);
 }
@@ -92,6 +96,7 @@ void print_head() {
 
 int main(int argc, char** argv) {
   std::string part = "all", csv, json_path;
+  int repeat = 1;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto value = [&]() -> std::string {
@@ -102,6 +107,8 @@ int main(int argc, char** argv) {
       part = value();
       if (part != "a" && part != "b" && part != "c" && part != "all")
         fesd_bench::usage("--part " + part + ": expected a, b, c or all");
+    } else if (a == "--repeat") {
+      repeat = fesd_bench::parse_int(a, value());
     } else if (a == "--csv") {
       csv = value();
     } else if (a == "--json") {
@@ -145,6 +152,7 @@ int main(int argc, char** argv) {
     const Mode modes[] = {{"eta (31)", fesd::StepEq::Eta},
                           {"l2_relaxed", fesd::StepEq::L2Relaxed},
                           {"heuristic_mean", fesd::StepEq::HeuristicMean},
+                          {"heuristic_delta", fesd::StepEq::HeuristicDelta},
                           {"none", fesd::StepEq::None}};
     std::vector<fesd::OcpResult> res;
     print_head();
@@ -193,31 +201,60 @@ int main(int argc, char** argv) {
 
   if (part == "c" || part == "all") {
     fmt::print(
-        "\n(c) PEERS.md row: nosnoc_py's variant of (61) (cost int v'v, q(4) = q_final, "
-        "heuristic_mean rho_h = 10)\n");
+        "\n(c) PEERS.md row: nosnoc_py's variant of (61) (cost int v'v, q(4) = q_final, v' = 2u), "
+        "time: median of {} run{}\n",
+        repeat, repeat == 1 ? "" : "s");
     print_head();
-    // Like for like with nosnoc_py, which does not pin sliding exits; then fesd's default.
-    fesd::OcpOptions as_nosnoc = fesd_bench::sliding_options();
-    as_nosnoc.discretization.pin_sliding_exits = false;
-    const fesd::OcpResult r = fesd::solve(fesd_bench::sliding_ocp_nosnoc(), as_nosnoc);
-    print_row("fesd, exits free", r);
-    const fesd::OcpResult pinned =
-        fesd::solve(fesd_bench::sliding_ocp_nosnoc(), fesd_bench::sliding_options());
-    print_row("fesd, exits pinned", pinned);
+    struct Row {
+      const char* name;
+      fesd::StepEq eq;
+      double rho_h;
+      bool pin;
+    };
+    // As nosnoc_py's example (heuristic_mean, rho_h = 10), like for like with exits free (nosnoc_py
+    // does not pin them), then fesd's default pinning; nosnoc_py's default step equilibration
+    // (HEURISTIC_DELTA, rho_h = 1); fesd's OCP default (l2_relaxed, rho_h = 1).
+    const Row rows[] = {{"mean 10, exits free", fesd::StepEq::HeuristicMean, 10, false},
+                        {"mean 10, pinned", fesd::StepEq::HeuristicMean, 10, true},
+                        {"delta 1, exits free", fesd::StepEq::HeuristicDelta, 1, false},
+                        {"delta 1, pinned", fesd::StepEq::HeuristicDelta, 1, true},
+                        {"l2_relaxed 1, pinned", fesd::StepEq::L2Relaxed, 1, true}};
+    const fesd::Ocp ocp = fesd_bench::sliding_ocp_nosnoc();
+    nlohmann::json rows_json = nlohmann::json::array();
+    std::vector<fesd::OcpResult> results;
+    for (const Row& row : rows) {
+      fesd::OcpOptions o = fesd_bench::sliding_options();
+      o.discretization.step_eq = row.eq;
+      o.discretization.rho_h = row.rho_h;
+      o.discretization.pin_sliding_exits = row.pin;
+      std::vector<double> wall;
+      fesd::OcpResult r;
+      for (int k = 0; k < repeat; ++k) {
+        r = fesd::solve(ocp, o);
+        wall.push_back(r.summary.wall_s);
+      }
+      std::sort(wall.begin(), wall.end());
+      r.summary.wall_s = wall[wall.size() / 2];
+      print_row(row.name, r);
+      nlohmann::json j = row_json(row.name, r);
+      j["wall_s_all"] = wall;
+      j["nlp_objective"] = r.homotopy.empty() ? NAN : r.homotopy.back().objective;
+      rows_json.push_back(j);
+      results.push_back(std::move(r));
+    }
     fmt::print("{:<20} {:<22} {:>12.7f} {:>9} {:>9} {:>5} {:>6} {:>8}\n", "nosnoc_py (PEERS)", "",
                5.596209, "", "", 10, 338, "2.7-3.6");
-    if (!r.homotopy.empty() && !pinned.homotopy.empty())
-      fmt::print(
-          "NLP objective with the heuristic_mean penalty (what nosnoc_py reports): {:.7f} (exits "
-          "free), {:.7f} (pinned)\n",
-          r.homotopy.back().objective, pinned.homotopy.back().objective);
+    fmt::print("NLP objective with the step-equilibration penalty (what nosnoc_py reports):");
+    for (std::size_t i = 0; i < results.size(); ++i)
+      fmt::print("{} {} {:.7f}", i == 0 ? "" : ",", rows[i].name,
+                 results[i].homotopy.empty() ? NAN : results[i].homotopy.back().objective);
+    const fesd::OcpResult& r = results.front();
     fmt::print(
-        "NLP size: {} variables (nosnoc_py: 1200); time: {:.2f} s derivatives, {:.2f} s "
+        "\nNLP size: {} variables (nosnoc_py: 1200); first row: {:.2f} s derivatives, {:.2f} s "
         "IPOPT + MUMPS, {:.3f} s setup; {:.1f} ms per IPOPT iteration\n",
         r.summary.n_variables, r.summary.derivative_s, r.summary.solver_s, r.summary.setup_s,
         1e3 * r.summary.wall_s / std::max(1, r.summary.nlp_iterations));
-    out["peers_row"] = row_json("nosnoc variant", r);
-    out["peers_row_pinned"] = row_json("nosnoc variant, exits pinned", pinned);
+    out["peers_rows"] = rows_json;
   }
   if (!json_path.empty()) {
     std::ofstream os(json_path);

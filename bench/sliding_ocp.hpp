@@ -5,13 +5,16 @@
 //        q' = -sign(c(x)) + v (componentwise), v' = u,  |v_i| <= 2,  |u_i| <= 10,
 //        c(x) = (phi_1, phi_2), phi_1 = q1 + 0.15 q2^2, phi_2 = -0.05 q1^3 + q2,
 //
-// with rho = 1e3 and q_final = (-pi/6, -pi/4); and nosnoc_py's variant of it (PEERS.md): cost
-// int v'v dt, terminal equality q(4) = q_final, |u| <= 10, no bound on v, heuristic_mean step
-// equilibration with rho_h = 10. Shared by bench/sliding_ocp.cpp, the tests and the examples.
+// with rho = 1e3 and q_final = (-pi/6, -pi/4); and nosnoc_py's variant of it (PEERS.md, its
+// examples/sliding_mode_ocp/sliding_mode_ocp.py): cost int v'v dt, terminal equality
+// q(4) = q_final, |u| <= 10, no bound on v, v' = 2u, heuristic_mean step equilibration with
+// rho_h = 10. Shared by bench/sliding_ocp.cpp, the tests and the examples.
 //
 // Cartesian product (Sect. 2.3), n_sys = 2: subsystem k switches on phi_k. x' = sum of the two
-// subsystems' convex combinations, so the smooth part (v in q', u in v') is written once, into
-// both regions of subsystem 1 (its theta sums to one).
+// subsystems' convex combinations. The paper's model writes the smooth part (v in q', u in v')
+// once, into both regions of subsystem 1 (its theta sums to one). nosnoc_py's example gives
+// subsystem k the fields (-+1 + v_k in q_k', u in v') in both its regions, so u enters v' once
+// per subsystem: v' = 2u.
 #pragma once
 #include <cmath>
 #include <numbers>
@@ -24,6 +27,7 @@
 namespace fesd_bench {
 
 struct SlidingModel {
+  bool nosnoc = false;  ///< nosnoc_py's layout: v' = 2u (u in both subsystems)
   template <class T>
   void c(const T* x, const T*, T* c) const {
     c[0] = x[0] + 0.15 * x[1] * x[1];
@@ -34,6 +38,13 @@ struct SlidingModel {
   template <class T>
   void f(int region, const T* x, const T* u, const T*, T* f) const {
     for (int i = 0; i < 4; ++i) f[i] = T(0.0);
+    if (nosnoc) {  // region 2k: phi_k > 0, q_k' = -1 + v_k; region 2k + 1: q_k' = 1 + v_k
+      const int k = region / 2;
+      f[k] = (region % 2 == 0 ? -1.0 : 1.0) + x[2 + k];
+      f[2] = u[0];
+      f[3] = u[1];
+      return;
+    }
     switch (region) {
       case 0:
       case 1:
@@ -49,11 +60,12 @@ struct SlidingModel {
   }
 };
 
-inline fesd::Pss sliding_model() {
-  return fesd::make_pss(SlidingModel{}, fesd::PssDims{.n_x = 4,
-                                                      .n_u = 2,
-                                                      .subsystems = {fesd::Subsystem::from_c(1),
-                                                                     fesd::Subsystem::from_c(1)}});
+inline fesd::Pss sliding_model(bool nosnoc = false) {
+  return fesd::make_pss(
+      SlidingModel{nosnoc},
+      fesd::PssDims{.n_x = 4,
+                    .n_u = 2,
+                    .subsystems = {fesd::Subsystem::from_c(1), fesd::Subsystem::from_c(1)}});
 }
 
 inline Eigen::Vector2d sliding_q_final() {
@@ -96,9 +108,11 @@ inline fesd::Ocp sliding_ocp_paper() {
   return ocp;
 }
 
-/// nosnoc_py's example (PEERS.md): cost int v'v, q(4) = q_final exactly, |u| <= 10, v free.
+/// nosnoc_py's example (PEERS.md): cost int v'v, q(4) = q_final exactly, |u| <= 10, v free,
+/// v' = 2u.
 inline fesd::Ocp sliding_ocp_nosnoc() {
   fesd::Ocp ocp = sliding_ocp_paper();
+  ocp.model = sliding_model(/*nosnoc=*/true);
   ocp.functions = fesd::make_ocp_functions(SlidingCost{false});
   ocp.lbx.resize(0);
   ocp.ubx.resize(0);

@@ -33,9 +33,15 @@ enum class StepEq {
   None,     ///< h_n free within its bounds
   Eta,      ///< (31): (h_n - h_{n-1}) eta_n = 0
   EtaTanh,  ///< (31) with tanh(eta_n), better scaled
-  /// penalty rho_h * sum_n (h_n - T / N_FE)^2 in the objective (nosnoc's HEURISTIC_MEAN; the
-  /// default of nosnoc_py is HEURISTIC_DELTA, rho_h * sum_n (h_n - h_{n-1})^2, not in fesd yet)
+  /// penalty rho_h * sum_n (h_n - T / N_FE)^2 over every element n in the objective (nosnoc's
+  /// HEURISTIC_MEAN; the default of nosnoc_py's later `Options`, not of its `NosnocOpts`)
   HeuristicMean,
+  /// penalty rho_h * sum_{n >= 1} (h_n - h_{n-1})^2 in the objective, unscaled, over the pairs of
+  /// neighbouring elements of one control interval (integration step), not across its
+  /// boundaries: nosnoc_py's HEURISTIC_DELTA, the default of its NosnocOpts (rho_h = 1). Pulls
+  /// neighbouring steps together, so like heuristic_mean it biases an OCP's switching times
+  /// where the grid must change at a switch (docs/formulation.md).
+  HeuristicDelta,
   /// penalty rho_h * sum_n tanh(eta_n) ((h_n - h_{n-1}) / h_0)^2: (31) as a smooth penalty. Zero
   /// on every piecewise-uniform grid whose steps change only at switches, so unlike
   /// heuristic_mean it does not bias a solution; unlike eta it has no corner where the grid
@@ -43,7 +49,7 @@ enum class StepEq {
   L2Relaxed,
 };
 /// Problem-file key `step_equilibration`: "none", "eta", "eta_tanh", "heuristic_mean",
-/// "l2_relaxed".
+/// "heuristic_delta", "l2_relaxed" (and nosnoc's spellings HEURISTIC_MEAN, HEURISTIC_DELTA).
 std::string_view to_string(StepEq v);
 bool parse(std::string_view name, StepEq& out);
 
@@ -75,7 +81,7 @@ struct DiscretizationOptions {
   StepEq step_eq = StepEq::HeuristicMean;                     ///< `step_equilibration`
   StageLambdaSign stage_lambda_sign = StageLambdaSign::Auto;  ///< `stage_lambda_sign`
   double gamma_h = 1.0;  ///< `gamma_h` in (0, 1]: h_n in [(1 - gamma_h) h0, (1 + gamma_h) h0] (59f)
-  double rho_h = 1.0;    ///< `rho_h` > 0: weight of the heuristic_mean penalty
+  double rho_h = 1.0;    ///< `rho_h` > 0: weight of the step-equilibration penalty
   /// `pin_sliding_exits`: FESD with a stiffly accurate scheme (Radau IIA, Lobatto IIIC) only.
   /// Where a solution leaves a sliding mode at an element boundary while the weight theta of the
   /// region it leaves is still > 0 there (an exit up to O(h) early, which the FESD equations

@@ -237,7 +237,9 @@ std::vector<Option> build() {
       kDisc, "gamma_h", kBoth, "step size freedom: h_n in [(1 - gamma_h) h, (1 + gamma_h) h]",
       "gamma_h", Range{.min = 0, .max = 1, .min_open = true}));
   o.push_back(scalar<&T::discretization, &D::rho_h>(
-      kDisc, "rho_h", kBoth, "weight of the heuristic_mean penalty", "rho_h", kPositive));
+      kDisc, "rho_h", kBoth,
+      "weight of the step-equilibration penalty (heuristic_mean, heuristic_delta, l2_relaxed)",
+      "rho_h", kPositive));
   o.push_back(scalar<&T::discretization, &D::pin_sliding_exits>(
       kDisc, "pin_sliding_exits", kBoth,
       "solve once more with sliding exits pinned where theta has not reached 0", ""));

@@ -18,8 +18,8 @@ namespace {
 constexpr std::array<std::string_view, 5> kRkScheme{"radau_iia", "gauss_legendre", "lobatto_iiia",
                                                     "lobatto_iiic", "explicit_rk"};
 constexpr std::array<std::string_view, 4> kCrossComp{"sparse", "stage_sum", "element", "neighbor"};
-constexpr std::array<std::string_view, 5> kStepEq{"none", "eta", "eta_tanh", "heuristic_mean",
-                                                  "l2_relaxed"};
+constexpr std::array<std::string_view, 6> kStepEq{
+    "none", "eta", "eta_tanh", "heuristic_mean", "heuristic_delta", "l2_relaxed"};
 constexpr std::array<std::string_view, 3> kStageLambdaSign{"all", "boundary", "auto"};
 constexpr std::array<std::string_view, 5> kMpccMode{
     "scholtes_ineq", "scholtes_eq", "fischer_burmeister", "ell_1_penalty", "elastic_ineq"};
@@ -103,6 +103,10 @@ std::string_view to_string(StepEq v) {
   return name_of(kStepEq, v);
 }
 bool parse(std::string_view name, StepEq& out) {
+  // nosnoc's spellings of the two modes that are the same penalty in fesd. nosnoc's L2_RELAXED,
+  // L2_RELAXED_SCALED and DIRECT differ from l2_relaxed and eta (scaling, tanh), so not those.
+  if (name == "HEURISTIC_MEAN") name = "heuristic_mean";
+  if (name == "HEURISTIC_DELTA") name = "heuristic_delta";
   return parse_from(kStepEq, name, out);
 }
 std::string_view to_string(MpccMode v) {

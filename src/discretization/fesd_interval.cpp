@@ -121,6 +121,17 @@ struct SquaredDeviation {
   }
 };
 
+/// (h_n - h_{n-1})^2, the heuristic_delta penalty term.  inputs: h_{n-1}, h_n
+struct SquaredDifference {
+  int num_inputs() const { return 2; }
+  int num_outputs() const { return 1; }
+  template <class T>
+  void operator()(const T* w, T* c) const {
+    const T d = w[1] - w[0];
+    c[0] = d * d;
+  }
+};
+
 /// Step equilibration (31): (h_n - h_{n-1}) * eta_n (or tanh(eta_n)), with
 ///   eta_n = prod_r ( sigma^{lambda,B}_r sigma^{lambda,F}_r + sigma^{theta,B}_r sigma^{theta,F}_r
 ///   ).
@@ -218,8 +229,8 @@ std::vector<std::string> FesdInterval::block_size_errors(const Pss& m,
       errors.push_back(fmt::format(
           "discretization.step_equilibration = {}: the step equilibration (31) of two neighbouring "
           "elements is one block of 2 + 4 n_theta = {} inputs with n_theta = {} regions; at most "
-          "{} inputs per block are supported, i.e. n_theta <= {} (use heuristic_mean or none, or "
-          "fewer regions)",
+          "{} inputs per block are supported, i.e. n_theta <= {} (use heuristic_mean, "
+          "heuristic_delta or none, or fewer regions)",
           to_string(se), step_eq, n_th, limit, (limit - 2) / 4));
   }
   return errors;
@@ -426,6 +437,10 @@ void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
     } else if (opt_.step_eq == StepEq::HeuristicMean) {
       auto pen = make_block(SquaredDeviation{h0});
       for (int n = 0; n < N_FE_; ++n) nlp.add_objective(pen, {h(n)}, opt_.rho_h);
+    } else if (opt_.step_eq == StepEq::HeuristicDelta) {
+      // Neighbours inside this interval only: nothing ties h_0 to the previous interval's last h.
+      auto pen = make_block(SquaredDifference{});
+      for (int n = 1; n < N_FE_; ++n) nlp.add_objective(pen, {h(n - 1), h(n)}, opt_.rho_h);
     }
   }
   build_complementarity();

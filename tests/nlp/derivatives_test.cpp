@@ -1,7 +1,7 @@
 // Exact derivatives of the assembled FESD NLP against central differences: the constraint
 // Jacobian, the objective gradient and the Hessian of the Lagrangian, for every block type
 // (stage equations, LP, boundary LP (33), step equilibration (31) with and without tanh, the
-// heuristic penalty, complementarity rows), several schemes and a two-subsystem model.
+// heuristic penalties, complementarity rows), several schemes and a two-subsystem model.
 // Also checks that no nonzero of the finite-difference Jacobian lies outside the declared pattern.
 #include <cmath>
 #include <map>
@@ -158,6 +158,7 @@ INSTANTIATE_TEST_SUITE_P(
                       Case{RkScheme::RadauIIA, 1, StepEq::EtaTanh, CrossComp::Sparse},
                       Case{RkScheme::GaussLegendre, 2, StepEq::Eta, CrossComp::Neighbor},
                       Case{RkScheme::LobattoIIIC, 3, StepEq::HeuristicMean, CrossComp::Element},
+                      Case{RkScheme::RadauIIA, 3, StepEq::HeuristicDelta, CrossComp::StageSum},
                       Case{RkScheme::ExplicitRK, 4, StepEq::EtaTanh, CrossComp::StageSum}));
 
 }  // namespace
