@@ -171,4 +171,16 @@ std::vector<std::string> validate(const IntegratorOptions& o);
 /// Throws fesd::InvalidOption with all messages of validate() if any.
 void check(const IntegratorOptions& o);
 
+/// Number of NLPs of one homotopy: N_homotopy, or (0) enough for sigma to reach sigma_N.
+int homotopy_length(const HomotopyOptions& o);
+/// The sigma of a homotopy's last NLP: max(sigma_N, sigma_0 slope^(homotopy_length - 1)).
+double final_sigma(const HomotopyOptions& o);
+/// Valid settings that cannot be expected to reach complementarity_tol, one sentence each: the
+/// homotopy's last sigma above complementarity_tol (sigma_N too large, or N_homotopy too small
+/// to get there). A relaxed NLP at sigma allows complementarity products up to sigma, so its
+/// solution meets the tolerance only by chance (fix_active_set may still rescue a step). The
+/// integrator and solve() copy them into Summary::warnings; `fesd check` and the CLI print them
+/// before a run.
+std::vector<std::string> warnings(const HomotopyOptions& o);
+
 }  // namespace fesd

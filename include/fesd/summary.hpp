@@ -78,6 +78,8 @@ struct Summary {
   int active_set_solves = 0;
   /// Such re-solves without exits to pin that failed: the homotopy's solution stays.
   int active_set_failures = 0;
+  /// Steps whose homotopy converged but missed complementarity_tol, completed by that re-solve.
+  int rescued_steps = 0;
   // ---- pinned sliding exits (DiscretizationOptions::pin_sliding_exits) ----
   /// Exits that left a sliding mode early (at an element boundary where the leaving region's
   /// theta was still > 0), each moved to where it reaches 0 in the re-solve.

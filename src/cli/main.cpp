@@ -408,6 +408,7 @@ void print_solver_header(const std::string& n_fe, const fesd::DiscretizationOpti
              nlp.tol, nlp.acceptable_tol, nlp.max_iter, nlp.print_level);
   for (const auto& [key, value] : nlp.extra) out::print(", {} = {}", key, value);
   out::print("\n");
+  for (const std::string& w : fesd::warnings(h)) out::print("  warning     {}\n", w);
 }
 
 void print_header(const fesd::SimulationProblem& problem) {

@@ -1,8 +1,10 @@
 // Enum names and option validation. Each enum has one name table, indexed by its values, behind
 // to_string, parse, the problem-file reader and the command line. validate() checks the ranges and
 // rules of the option registry (option_registry.cpp).
+#include <algorithm>
 #include <array>
 #include <cctype>
+#include <cmath>
 #include <string>
 
 #include <fmt/format.h>
@@ -140,6 +142,37 @@ std::vector<std::string> validate(const DiscretizationOptions& o) {
 
 std::vector<std::string> validate(const HomotopyOptions& o) {
   return registry::check(registry::Table::Homotopy, registry::target_of(o));
+}
+
+int homotopy_length(const HomotopyOptions& o) {
+  if (o.max_homotopy_steps > 0) return o.max_homotopy_steps;
+  return 1 + static_cast<int>(std::ceil(
+                 std::log(o.sigma_N / o.sigma_0) / std::log(o.homotopy_update_slope) - 1e-9));
+}
+
+double final_sigma(const HomotopyOptions& o) {
+  // As the homotopy computes it: sigma_{k+1} = max(slope sigma_k, sigma_N).
+  double sigma = o.sigma_0;
+  for (int k = 1; k < homotopy_length(o); ++k)
+    sigma = std::max(o.homotopy_update_slope * sigma, o.sigma_N);
+  return sigma;
+}
+
+std::vector<std::string> warnings(const HomotopyOptions& o) {
+  if (!validate(o).empty()) return {};  // invalid settings are errors, reported elsewhere
+  const double last = final_sigma(o);
+  if (last <= o.complementarity_tol) return {};
+  const bool too_few = last > o.sigma_N * (1 + 1e-9);
+  const std::string why =
+      too_few ? fmt::format("N_homotopy = {} NLPs take sigma from sigma_0 = {:g} only down to {:g}",
+                            o.max_homotopy_steps, o.sigma_0, last)
+              : fmt::format("sigma_N = {:g}", o.sigma_N);
+  return {fmt::format(
+      "homotopy: {}, above complementarity_tol = {:g}: the last NLP allows complementarity "
+      "products up to sigma and meets the tolerance only by chance; {}",
+      why, o.complementarity_tol,
+      too_few ? "raise N_homotopy (0: automatic) or lower sigma_N"
+              : "set sigma_N <= complementarity_tol")};
 }
 
 std::vector<std::string> validate(const NlpOptions& o) {

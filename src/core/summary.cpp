@@ -67,6 +67,10 @@ std::string format_work(const Summary& s, double per_step) {
     out += fmt::format("  fixed active set     {} re-solve{}  ({} failed: relaxed solution kept)\n",
                        s.active_set_solves, s.active_set_solves == 1 ? "" : "s",
                        s.active_set_failures + s.pin_failures);
+  if (s.rescued_steps > 0)
+    out += fmt::format(
+        "  rescued steps        {}  (complementarity_tol missed, met by the fixed active set)\n",
+        s.rescued_steps);
   if (s.pinned_exits > 0 || s.pin_failures > 0)
     out += fmt::format("  pinned sliding exits {}  ({} re-solve{} failed, unpinned)\n",
                        s.pinned_exits, s.pin_failures, s.pin_failures == 1 ? "" : "s");

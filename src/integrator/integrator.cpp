@@ -156,7 +156,10 @@ class Integrator {
         u_(std::move(u)),
         p_(std::move(p)),
         levels_(kMaxSplit + 1),
-        x_(x0) {
+        x_(x0),
+        settings_cannot_reach_(final_sigma(options.homotopy) >
+                               options.homotopy.complementarity_tol) {
+    res_.summary.warnings = warnings(options.homotopy);
     // Initial guess of the first step: the LP at x0 (then the last stage of the step before).
     guess_ = dcs::solve_lp(model_, x0, p_);
     guess_xdot_ = xdot_at(x0, guess_.theta);
@@ -198,7 +201,7 @@ class Integrator {
   /// times halved).
   bool advance(int k) {
     if (solve_step(k, 0)) return true;
-    if (!d_.use_fesd) return false;
+    if (!d_.use_fesd || !retry_can_help(last_)) return false;
     return retry_refined(k) || retry_split(k);
   }
 
@@ -230,16 +233,21 @@ class Integrator {
     HomotopyOptions hopt = options_.homotopy;
     if (careful_) hopt.intermediate_tol = 0;
     std::vector<HomotopyRow> rows;
+    std::vector<int> unlocated;  // regions whose exit in this step could not be pinned
+    StepProblem* solved = &sp;   // the problem whose solution is the step
     mpcc::HomotopyResult hr = homotopy(sp, hopt, rows);
-    if (hr.status != Status::Success && hopt.intermediate_tol > 0) hr = retry_tight(sp, hopt, rows);
+    rescue(sp, hr, rows, unlocated);
+    if (retry_can_help(hr) && hopt.intermediate_tol > 0) {
+      hr = retry_tight(sp, hopt, rows);
+      rescue(sp, hr, rows, unlocated);
+    }
     if (hr.status != Status::Success) careful_ = true;
-    StepProblem* solved = &sp;  // the problem whose solution is the step
-    if (hr.status != Status::Success && can_fall_back()) {
+    if (retry_can_help(hr) && can_fall_back()) {
       solved = &fallback(k, r, sp);
       hr = retry_sparse(*solved, hopt, rows);
+      rescue(*solved, hr, rows, unlocated);
     }
-    std::vector<int> unlocated;  // regions whose exit in this step could not be pinned
-    if (hr.status == Status::Success && solved->iv->can_pin_exits())
+    if (hr.status == Status::Success && !hr.active_set_fixed && solved->iv->can_pin_exits())
       unlocated = resolve_fixed(*solved, hr, rows);
     res_.homotopy.push_back(std::move(rows));
     last_ = hr;
@@ -253,6 +261,27 @@ class Integrator {
     accept(*solved);
     if (!unlocated.empty()) mark_unlocated(first_switch, t_step, unlocated);
     return true;
+  }
+
+  /// A homotopy whose NLPs converged but whose complementarity residual stayed above
+  /// complementarity_tol (e.g. sigma_N above it, nosnoc's settings): the re-solve with the active
+  /// set fixed (fix_active_set) makes complementarity exact, and the step succeeds after all.
+  void rescue(StepProblem& sp, mpcc::HomotopyResult& hr, std::vector<HomotopyRow>& rows,
+              std::vector<int>& unlocated) {
+    if (hr.status != Status::ComplementarityNotMet || !options_.homotopy.fix_active_set ||
+        !sp.iv->can_pin_exits())
+      return;
+    unlocated = resolve_fixed(sp, hr, rows);
+    if (hr.status == Status::Success) ++res_.summary.rescued_steps;
+  }
+
+  /// Whether another attempt of the step can reach what this one did not: not when its NLPs
+  /// converged and only complementarity_tol was missed while the settings cannot reach it (the
+  /// homotopy's last sigma above it, warnings(HomotopyOptions)): every retry ends at the same
+  /// sigma.
+  bool retry_can_help(const mpcc::HomotopyResult& hr) const {
+    if (hr.status == Status::Success) return false;
+    return !(hr.status == Status::ComplementarityNotMet && settings_cannot_reach_);
   }
 
   /// The same NLPs from the same start, each solved to ipopt.tol (no intermediate_tol).
@@ -301,8 +330,13 @@ class Integrator {
     if (pins.empty() && !options_.homotopy.fix_active_set) return {};
     std::vector<nlp::Bound> bounds = iv.pin_bounds(w.data(), pins);
     const int h0 = iv.h(0);
+    // A step-start exit: element 0 in [delta / 2, 4 delta] around the predicted exit time delta
+    // (its guess moves into it): from the homotopy's element length, often 50x the exit's, IPOPT
+    // needs ~90 iterations and may stop at its acceptable level (belt, N_sim = 240: exit time
+    // off by 4.9e-6 -> 6.3e-8).
     if (h0_min > 0 && h0_min < sp.mpcc.upper(h0))
-      bounds.push_back({h0, std::max(sp.mpcc.lower(h0), h0_min), sp.mpcc.upper(h0)});
+      bounds.push_back(
+          {h0, std::max(sp.mpcc.lower(h0), h0_min), std::min(sp.mpcc.upper(h0), 4 * h0_min)});
     const int n_pins = static_cast<int>(pins.size());
     const mpcc::HomotopyResult again =
         sp.mpcc.solve_again(*solver_, options_.homotopy, bounds, n_pins);
@@ -311,7 +345,16 @@ class Integrator {
       ++res_.summary.active_set_solves;
       res_.summary.pinned_exits += n_pins;
       hr.comp_residual = again.comp_residual;
-      return {};
+      hr.status = Status::Success;
+      hr.active_set_fixed = true;
+      // Converged only to IPOPT's acceptable_tol: the exit is where that point puts it, which
+      // can be off by more than the state (an exit within a small fraction of an element after
+      // the step start: the stage equations of a tiny element hold theta loosely).
+      if (n_pins == 0 || again.last_nlp_status == "Solve_Succeeded") return {};
+      std::vector<int> regions;
+      for (const auto& pin : pins) regions.push_back(pin.r);
+      unlocated_why_ = "the re-solve with the exit pinned converged only to ipopt.acceptable_tol";
+      return regions;
     }
     if (n_pins == 0) {
       ++res_.summary.active_set_failures;
@@ -320,6 +363,7 @@ class Integrator {
     ++res_.summary.pin_failures;
     std::vector<int> regions;
     for (const auto& pin : pins) regions.push_back(pin.r);
+    unlocated_why_ = "the re-solve with the exit pinned failed";
     return regions;
   }
 
@@ -333,11 +377,11 @@ class Integrator {
         if (std::find(regions.begin(), regions.end(), r) != regions.end()) s.located = false;
     }
     res_.summary.warnings.push_back(fmt::format(
-        "the sliding exit{} of region{} {} in the step from t = {:.6g} could not be located (the "
-        "re-solve with the exit pinned failed): its switch time may be off by up to one element "
-        "length, {:.3g}; try another N_sim",
+        "the sliding exit{} of region{} {} in the step from t = {:.6g} could not be located "
+        "exactly ({}): its switch time may be off by up to one element length, {:.3g}; try "
+        "another N_sim",
         regions.size() == 1 ? "" : "s", regions.size() == 1 ? "" : "s", fmt::join(regions, ", "),
-        t_step, T_step_ / d_.N_FE));
+        t_step, unlocated_why_, T_step_ / d_.N_FE));
   }
 
   /// The previous step ended sliding with theta_r > 0 (guess_.theta: its last stage), and this
@@ -480,6 +524,8 @@ class Integrator {
   bool careful_ = false;                 // an attempt of the current step failed
   mpcc::HomotopyResult last_;            // of the last attempt
   const StepProblem* failed_ = nullptr;  // the last failed attempt
+  const bool settings_cannot_reach_;     // the homotopy's last sigma > complementarity_tol
+  std::string unlocated_why_;            // why the last unlocated exit is
 };
 
 }  // namespace

@@ -59,6 +59,7 @@ json stats(const Summary& s) {
               {"split_steps", s.split_steps},
               {"active_set_solves", s.active_set_solves},
               {"active_set_failures", s.active_set_failures},
+              {"rescued_steps", s.rescued_steps},
               {"pinned_exits", s.pinned_exits},
               {"pin_failures", s.pin_failures},
               {"warnings", s.warnings}};

@@ -50,12 +50,6 @@ Status final_status(bool nlp_ok, bool eval_failed, double comp, double comp_tol)
   return Status::ComplementarityNotMet;
 }
 
-// Number of NLPs of an automatic homotopy: until sigma reaches sigma_N.
-int homotopy_length(const HomotopyOptions& o) {
-  if (o.max_homotopy_steps > 0) return o.max_homotopy_steps;
-  return 1 + static_cast<int>(std::ceil(
-                 std::log(o.sigma_N / o.sigma_0) / std::log(o.homotopy_update_slope) - 1e-9));
-}
 }  // namespace
 
 double comp_residual(const double* x, const std::vector<CompPair>& pairs) {

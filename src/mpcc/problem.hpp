@@ -41,6 +41,8 @@ struct HomotopyResult {
   double eval_s = 0, solver_s = 0;  ///< evaluation time, and NLP solver time without evaluations
   int nlp_iterations = 0;
   std::string last_nlp_status;
+  /// Set by the caller when the result is that of a re-solve with the active set fixed.
+  bool active_set_fixed = false;
 };
 
 /// Adds a homotopy's (or re-solve's) rows to `rows` and its work (NLPs, iterations, evaluation

@@ -483,6 +483,7 @@ OcpResult solve(const Ocp& ocp, const OcpOptions& options) {
     simulated = guess_simulation(*b, ocp, options, p);
   if (!simulated) guess_constant(*b, ocp, p);
   mp.finalize();
+  res.summary.warnings = warnings(options.homotopy);
   res.summary.n_variables = mp.num_variables();
   res.summary.n_constraints = mp.num_constraints();
   res.summary.setup_s = seconds_since(t_start);
