@@ -347,14 +347,7 @@ class Integrator {
       hr.comp_residual = again.comp_residual;
       hr.status = Status::Success;
       hr.active_set_fixed = true;
-      // Converged only to IPOPT's acceptable_tol: the exit is where that point puts it, which
-      // can be off by more than the state (an exit within a small fraction of an element after
-      // the step start: the stage equations of a tiny element hold theta loosely).
-      if (n_pins == 0 || again.last_nlp_status == "Solve_Succeeded") return {};
-      std::vector<int> regions;
-      for (const auto& pin : pins) regions.push_back(pin.r);
-      unlocated_why_ = "the re-solve with the exit pinned converged only to ipopt.acceptable_tol";
-      return regions;
+      return {};
     }
     if (n_pins == 0) {
       ++res_.summary.active_set_failures;
@@ -363,7 +356,6 @@ class Integrator {
     ++res_.summary.pin_failures;
     std::vector<int> regions;
     for (const auto& pin : pins) regions.push_back(pin.r);
-    unlocated_why_ = "the re-solve with the exit pinned failed";
     return regions;
   }
 
@@ -377,11 +369,11 @@ class Integrator {
         if (std::find(regions.begin(), regions.end(), r) != regions.end()) s.located = false;
     }
     res_.summary.warnings.push_back(fmt::format(
-        "the sliding exit{} of region{} {} in the step from t = {:.6g} could not be located "
-        "exactly ({}): its switch time may be off by up to one element length, {:.3g}; try "
-        "another N_sim",
+        "the sliding exit{} of region{} {} in the step from t = {:.6g} could not be located (the "
+        "re-solve with the exit pinned failed): its switch time may be off by up to one element "
+        "length, {:.3g}; try another N_sim",
         regions.size() == 1 ? "" : "s", regions.size() == 1 ? "" : "s", fmt::join(regions, ", "),
-        t_step, unlocated_why_, T_step_ / d_.N_FE));
+        t_step, T_step_ / d_.N_FE));
   }
 
   /// The previous step ended sliding with theta_r > 0 (guess_.theta: its last stage), and this
@@ -525,7 +517,6 @@ class Integrator {
   mpcc::HomotopyResult last_;            // of the last attempt
   const StepProblem* failed_ = nullptr;  // the last failed attempt
   const bool settings_cannot_reach_;     // the homotopy's last sigma > complementarity_tol
-  std::string unlocated_why_;            // why the last unlocated exit is
 };
 
 }  // namespace
