@@ -603,6 +603,24 @@ std::vector<nlp::Bound> FesdInterval::pin_bounds(const double* w,
     }
     if (pin.theta_zero && pin.n + 1 < N_FE_) std::erase(active[pin.n + 1], pin.r);
   }
+  // The interval's own lambda_{0,0} (lp_at_start) is tied to the fixed start state s0 by the LP
+  // (9). With every region of a sliding mode fixed to lambda = 0 there, g_r(s0) - mu = 0 for
+  // each of them repeats c(s0) = 0, an equation too many (s0 is given): the Jacobian loses rank
+  // and IPOPT crawls to its acceptable level. One active region per subsystem keeps a free
+  // lambda_{0,0} instead, without its sign bound (it equals g_r(s0) - mu = O(1e-16) of either
+  // sign; with lambda >= 0 the bound would become active and the problem degenerate again).
+  auto free_at_start = [&](const std::vector<int>& a0, int r) {
+    if (!in_.lp_at_start) return false;
+    for (int k = 0; k < model_.n_sys(); ++k) {
+      const int first = model_.region_offset(k), end = model_.region_offset(k + 1);
+      if (r < first || r >= end) continue;
+      int n_active = 0, last = -1;
+      for (int j = first; j < end; ++j)
+        if (has(a0, j)) ++n_active, last = j;
+      return n_active > 1 && r == last;
+    }
+    return false;
+  };
   std::vector<nlp::Bound> bounds;
   for (int n = 0; n < N_FE_; ++n)
     for (int r = 0; r < model_.n_theta(); ++r) {
@@ -614,7 +632,12 @@ std::vector<nlp::Bound> FesdInterval::pin_bounds(const double* w,
         continue;
       }
       // (a free-sign stage lambda too: theta lambda = 0 with theta > 0)
-      for (const std::vector<int>& point : points_[n]) bounds.push_back({point[r], 0.0, 0.0});
+      for (std::size_t q = 0; q < points_[n].size(); ++q) {
+        if (n == 0 && q == 0 && free_at_start(active[0], r))
+          bounds.push_back({points_[n][q][r], -nlp::kInf, nlp::kInf});
+        else
+          bounds.push_back({points_[n][q][r], 0.0, 0.0});
+      }
     }
   for (const ExitPin& pin : pins)
     if (pin.theta_zero) bounds.push_back({theta(pin.n, n_s_ - 1, pin.r), 0.0, 0.0});

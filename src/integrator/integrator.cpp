@@ -330,7 +330,7 @@ class Integrator {
     if (pins.empty() && !options_.homotopy.fix_active_set) return {};
     std::vector<nlp::Bound> bounds = iv.pin_bounds(w.data(), pins);
     const int h0 = iv.h(0);
-    // A step-start exit: element 0 in [delta / 2, 4 delta] around the predicted exit time delta
+    // A step-start exit: element 0 in [delta / 2, 2 delta] around the predicted exit time delta
     // (its guess moves into it): from the homotopy's element length, often 50x the exit's, IPOPT
     // needs ~90 iterations and may stop at its acceptable level (belt, N_sim = 240: exit time
     // off by 4.9e-6 -> 6.3e-8).
