@@ -7,6 +7,7 @@
 // horizon whose switches are known from an event-driven reference solution (matrix exponentials
 // for the relay, RK4 with step 1e-3 and bisection for the others, accurate to 1e-9 or better).
 #include <algorithm>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -150,5 +151,43 @@ TEST_P(PeriodicStickSlip, SticksOnOneSurfaceThenOnBoth) {
 }
 
 INSTANTIATE_TEST_SUITE_P(CompTol, PeriodicStickSlip, ::testing::ValuesIn(kTolerances), name_of);
+
+// The end of the codimension-2 stick: from the exact state at t = 2.6 (x1 = 0.9409579470, on both
+// surfaces) x1 reaches 1 at t = 2.6 + 0.1880473077, where both contacts slip at once (region 0
+// alone). Two steps of the file's grid. At complementarity_tol 1e-9 the exit is pinned and
+// located (measured 4.8e-7 early); at 1e-12 it comes 5.5e-4 early with located = false.
+SimulationProblem stick_slip_from_the_intersection(const Tolerance& tol) {
+  SimulationProblem p = load_example("periodic_stick_slip.toml", tol);
+  fesd::apply_override(p, "x0", "0.9409579470134545, 0.2, 0.4");
+  fesd::apply_override(p, "T_sim", "0.4");
+  fesd::apply_override(p, "N_sim", "2");
+  return p;
+}
+
+constexpr double kCodim2Exit = 0.1880473077;
+
+TEST(PeriodicStickSlipExit, BothContactsSlipWhenX1ReachesOne) {
+  const IntegratorResult r = simulate(stick_slip_from_the_intersection({"1e-9", "1e-10"}));
+  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+  ASSERT_EQ(r.switches.size(), 1u);
+  EXPECT_EQ(r.switches[0].after, std::vector<int>{0});
+  EXPECT_TRUE(r.switches[0].located);
+  EXPECT_NEAR(r.switches[0].t, kCodim2Exit, 1e-6);
+  EXPECT_EQ(r.summary.pin_failures, 0);
+}
+
+// Known gap (disabled until fixed): at complementarity_tol 1e-6 the homotopy keeps every element
+// of the first step on the intersection (regions {0, 1, 2, 3}), the pinned re-solve of step 0 ends
+// in "Infeasible_Problem_Detected" (pin_failures = 1, a warning names "the step from t = 0"), and
+// the exit is listed at the step boundary t = 0.2, 1.2e-2 late, with located = true: the switch
+// at a step boundary is recorded by the next step, and only the switches recorded by the step
+// whose pin failed are marked (Integrator::mark_unlocated).
+TEST(PeriodicStickSlipExit, DISABLED_AnExitAtAStepBoundaryIsLocatedOrMarked) {
+  const IntegratorResult r = simulate(stick_slip_from_the_intersection({"1e-6", "1e-8"}));
+  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+  ASSERT_EQ(r.switches.size(), 1u);
+  const fesd::SwitchEvent& s = r.switches[0];
+  EXPECT_TRUE(!s.located || std::abs(s.t - kCodim2Exit) < 1e-6) << "t = " << s.t;
+}
 
 }  // namespace
