@@ -49,7 +49,7 @@ struct Accuracy {
   double noise_floor = 0;
   bool at_noise_floor = false;  ///< the estimate came out below noise_floor and was raised to it
   /// Two estimates from three runs (the last pair, and the pair before carried over at order p)
-  /// agree within a factor kConsistency: the runs converge at the scheme's order.
+  /// agree within a factor 8: the runs converge at the scheme's order.
   bool consistent = false;
   int order = 0;       ///< p used: the scheme's classical order (1: standard method with switches)
   double tol_sim = 0;  ///< the target (0: none, N_sim given)
@@ -120,9 +120,10 @@ struct AccuracyOptions {
 };
 
 /// Simulates like integrate() with a step count chosen by AccuracyOptions and estimates the error
-/// of the result (IntegratorResult::accuracy), from runs at several N_sim: the finest one is
-/// returned. Status::ToleranceNotMet if tol_sim was not reached with N_sim_max steps (the finest
-/// result is still returned). Bad input throws fesd::Error as integrate() does.
+/// of the result (IntegratorResult::accuracy) from runs at several N_sim (docs/problem-files.md,
+/// "Accuracy"). Returns the run at the given N_sim, or the last run of a search for tol_sim;
+/// Status::ToleranceNotMet if tol_sim was not reached within N_sim_max steps (the finest successful
+/// run is still returned, with its estimate). Bad input throws fesd::Error as integrate() does.
 IntegratorResult simulate(const Pss& model, const Eigen::VectorXd& x0, double T_sim,
                           const AccuracyOptions& accuracy, const IntegratorOptions& options = {},
                           const Eigen::VectorXd& u = {}, const Eigen::VectorXd& p = {});

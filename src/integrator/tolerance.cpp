@@ -106,9 +106,11 @@ std::string list_N(const std::vector<int>& Ns) {
   return s;
 }
 
-/// The two estimates of the result's error (NaN where unavailable).
+/// The two estimates of the result's error (NaN where unavailable), and why they are rough
+/// (one sentence each; empty if they agree).
 struct Estimates {
   PairEstimate e1, e2;
+  std::vector<std::string> rough;
 };
 
 /// Fills `a` (estimate, switch times, consistency, note) for the result run r from its
@@ -160,14 +162,23 @@ Estimates estimate(Accuracy& a, const Run& r, const Run* c, const Run* d,
   const double big = std::max(std::max(e.e1.x, e.e2.x), a.noise_floor);
   const double small = std::max(std::min(e.e1.x, e.e2.x), a.noise_floor);
   a.consistent = big <= kConsistency * small;
-  if (a.at_noise_floor) {
+  if (a.at_noise_floor)
     a.note += fmt::format("; the runs agree to the NLP noise floor {:.1e}", a.noise_floor);
-  } else if (!a.consistent) {
-    a.note += fmt::format(
-        "; rough: the last two pairs give {:.1e} and {:.1e} (not within a factor "
-        "{:g}: not yet converging at order {})",
-        e.e1.x, e.e2.x, kConsistency, p);
-  }
+  else if (!a.consistent)
+    e.rough.push_back(fmt::format(
+        "the error estimate is rough: the last two pairs of runs give {:.1e} and {:.1e}, not "
+        "within a factor {:g} (not yet converging at order {})",
+        e.e1.x, e.e2.x, kConsistency, p));
+  if (!r.result.switches.empty() && !a.switch_times_consistent && !std::isnan(e.e2.t_s))
+    e.rough.push_back(fmt::format(
+        "the switch time estimate is rough: the last two pairs of runs give {:.1e} and {:.1e} (a "
+        "switch moves between the runs more than order {} predicts)",
+        e.e1.t_s, e.e2.t_s, p));
+  if (!r.result.switches.empty() && std::isnan(a.switch_time_estimate))
+    a.note +=
+        "; no switch time estimate: the runs give the same switch times to round-off while x(T) "
+        "differs (an element that no run refines, such as [0, t_s] shorter than every step)";
+  for (const std::string& why : e.rough) a.note += "; " + why;
   return e;
 }
 
@@ -227,14 +238,12 @@ class Simulation {
     const Run* pd = d.ok() && same_switches(r.result, d.result) ? &d : nullptr;
     if (pc == nullptr) std::swap(pc, pd);  // compare with the one that matches
     Accuracy a;
-    estimate(a, r, pc, pd, opt_);
+    const Estimates e = estimate(a, r, pc, pd, opt_);
     if (pc == nullptr) {
       a.note = different_switches_note(r, {&c, &d});
       r.result.summary.warnings.push_back(a.note);
-    } else if (pd != nullptr && !a.consistent) {
-      r.result.summary.warnings.push_back("the error estimate is rough: " +
-                                          a.note.substr(a.note.find("; rough: ") + 9));
     }
+    for (const std::string& why : e.rough) r.result.summary.warnings.push_back(why);
     infos_.front().error_estimate = a.error_estimate;
     return finish(std::move(r), std::move(a));
   }
@@ -247,6 +256,7 @@ class Simulation {
     std::vector<Run> ok;  // the successful runs, N increasing
     Run last_failed;
     Accuracy a;
+    Estimates e;
     for (;;) {
       Run r = run(N);
       if (r.ok()) {
@@ -258,15 +268,17 @@ class Simulation {
                 ? &ok[ok.size() - 2]
                 : nullptr;
         a = Accuracy{};
-        estimate(a, r, c, d, opt_);
+        e = estimate(a, r, c, d, opt_);
         if (c == nullptr && !ok.empty()) a.note = different_switches_note(r, {&ok.back()});
         infos_.back().error_estimate = a.error_estimate;
         report();
         ok.push_back(std::move(r));
         a.met = a.consistent && a.error_estimate <= tol;
-        if (a.met || N >= N_cap) break;
+        // A target below the noise floor: the runs cannot show more than that they agree to it.
+        const bool floor_reached = a.consistent && a.at_noise_floor;
+        if (a.met || floor_reached || N >= N_cap) break;
         int next = 2 * N;
-        if (!std::isnan(a.error_estimate)) {
+        if (!std::isnan(a.error_estimate) && !a.at_noise_floor) {
           const double want = N * std::pow(a.error_estimate / tol, 1.0 / a.order) * kSafety;
           next = static_cast<int>(std::ceil(std::clamp(want, 2.0 * N, double(kMaxGrowth) * N)));
         }
@@ -281,12 +293,21 @@ class Simulation {
     a.tol_sim = tol;
     if (ok.empty()) return finish(std::move(last_failed), tol, "no estimate: every run failed");
     Run best = std::move(ok.back());
+    for (const std::string& why : e.rough) best.result.summary.warnings.push_back(why);
     if (a.met) return finish(std::move(best), std::move(a));
     // Not reached: the finest successful run, saying why.
     best.result.status = Status::ToleranceNotMet;
+    if (a.consistent && a.at_noise_floor) {
+      best.result.message = fmt::format(
+          "tol_sim = {:g} is below the noise floor {:.1e} of the NLP solutions (10 ipopt.tol "
+          "max(1, |x(T)|), or complementarity_tol where the active set is not fixed): the runs "
+          "agree to that floor at N_sim = {}",
+          tol, a.noise_floor, best.N_sim);
+      return finish(std::move(best), std::move(a));
+    }
     std::string why;
     if (std::isnan(a.error_estimate))
-      why = "no error estimate (" + a.note + ")";
+      why = a.note;
     else if (a.error_estimate > tol)
       why = fmt::format("the error estimate is {:.2e}", a.error_estimate);
     else
@@ -318,16 +339,19 @@ class Simulation {
       return fmt::format("{} switch{}", n, n == 1 ? "" : "es");
     };
     std::string s = fmt::format("no estimate: the run at N_sim = {} has {}", r.N_sim, count(r));
+    bool differ = false;
     for (const Run* x : others) {
       if (x->N_sim == 0) continue;
-      if (!x->ok())
+      if (!x->ok()) {
         s += fmt::format(", the one at {} failed ({})", x->N_sim, to_string(x->result.status));
-      else if (same_switches(r.result, x->result))
+      } else if (same_switches(r.result, x->result)) {
         s += fmt::format(", the one at {} the same", x->N_sim);
-      else
+      } else {
         s += fmt::format(", the one at {} {}", x->N_sim, count(*x));
+        differ = true;
+      }
     }
-    return s + " (a run too coarse to resolve every switch; refine N_sim)";
+    return differ ? s + " (a run too coarse to resolve every switch; a larger N_sim helps)" : s;
   }
 
   void report() const {
@@ -410,8 +434,8 @@ std::string format_accuracy(const Accuracy& a) {
                        a.at_noise_floor ? "<= " : "", a.error_estimate, target);
   }
   if (!std::isnan(a.switch_time_estimate))
-    out += fmt::format("  switch time estimate {:.1e}  (max |t_s - t_s,exact|)\n",
-                       a.switch_time_estimate);
+    out += fmt::format("  switch time estimate {:.1e}  (max |t_s - t_s,exact|{})\n",
+                       a.switch_time_estimate, a.switch_times_consistent ? "" : "; rough");
   std::vector<int> Ns;
   double wall = 0;
   for (const AccuracyRun& r : a.runs) {

@@ -259,6 +259,18 @@ TEST(ErrorEstimate, ExactRunsGiveTheNoiseFloor) {
   EXPECT_NE(a.note.find("noise floor"), std::string::npos) << a.note;
   EXPECT_NEAR(r.x_final()[0], 1.0 - 1.0 / 3.0, 1e-10);
   EXPECT_NE(r.full_report().find("<= 1.0e-11"), std::string::npos) << r.full_report();
+
+  // A target below the floor cannot be shown: the search stops once three runs agree to the
+  // floor (doubling from N_sim = 2), and says so.
+  fesd::apply_override(q, "tol_sim", "1e-13");
+  fesd::apply_override(q, "N_sim", "2");
+  const fesd::IntegratorResult below = fesd::simulate(q);
+  EXPECT_EQ(below.status, fesd::Status::ToleranceNotMet);
+  EXPECT_EQ(run_sizes(below.accuracy), (std::vector<int>{2, 4, 8}));
+  EXPECT_TRUE(below.accuracy.at_noise_floor);
+  EXPECT_NE(below.message.find("tol_sim = 1e-13 is below the noise floor 1.0e-11"),
+            std::string::npos)
+      << below.message;
 }
 
 // A target that cannot be met within N_sim_max: the finest run is returned, with its estimate, as
