@@ -61,7 +61,7 @@ inline void build_step(const SimulationProblem& q) {
   in.lambda_start = free_vars(nlp, m.n_theta(), 0.0);
   in.mu_start = free_vars(nlp, m.n_sys(), -nlp::kInf);
   in.lp_at_start = o.use_fesd;
-  in.T = q.T_sim / q.N_sim;
+  in.T = q.T_sim / std::max(q.N_sim, 1);  // N_sim = 0: chosen by simulate(), at least one step
   in.boundary_at_end = true;
   discretization::FesdInterval iv(m, make_tableau(o.rk_scheme, o.n_s), o);
   iv.build(nlp, in);

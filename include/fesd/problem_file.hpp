@@ -7,6 +7,7 @@
 
 #include <Eigen/Dense>
 
+#include "fesd/integrator.hpp"
 #include "fesd/model.hpp"
 #include "fesd/ocp.hpp"
 #include "fesd/options.hpp"
@@ -23,12 +24,19 @@ struct SimulationProblem {
   Eigen::VectorXd u;        ///< [simulation] u: constant control values (size n_u)
   Eigen::VectorXd p;        ///< parameter values from [model] p (size n_p)
   double T_sim = 0;         ///< [simulation] T_sim > 0
-  int N_sim = 1;            ///< [simulation] N_sim >= 1
+  int N_sim = 0;            ///< [simulation] N_sim >= 0; 0: chosen by tol_sim (simulate())
+  double tol_sim = 0;       ///< [simulation] tol_sim >= 0 (AccuracyOptions::tol_sim)
+  int N_sim_max = 1000;     ///< [simulation] N_sim_max >= 1 (AccuracyOptions::N_sim_max)
   IntegratorOptions options;
   /// True if an expression uses the time `t`: then a clock state named "t" with t' = 1 is
   /// appended to x (nosnoc does the same), and its initial value is [simulation] t0 (default 0).
   bool has_clock = false;
 };
+
+/// Simulates the problem with simulate(): N_sim steps, or as many as tol_sim needs, with an
+/// error estimate (IntegratorResult::accuracy). `on_run`: progress after every run.
+IntegratorResult simulate(const SimulationProblem& problem,
+                          const std::function<void(const AccuracyRun&)>& on_run = {});
 
 /// Reads and validates a problem file. Throws fesd::ProblemFileError / ExpressionError /
 /// InvalidOption with "file:line: what is wrong" messages.

@@ -10,6 +10,9 @@ enum class Status {
   ComplementarityNotMet,   ///< the homotopy ended with the complementarity residual above tol
   NlpFailed,               ///< IPOPT failed (infeasible, iteration limit, restoration failure, ...)
   EvaluationFailed,        ///< a user function returned NaN or inf at every trial point
+  /// simulate(): every run succeeded, but the error estimate did not reach tol_sim within
+  /// N_sim_max steps (the result is the finest run, with its estimate)
+  ToleranceNotMet,
 };
 
 /// Short identifier, e.g. "success", "nlp_failed".

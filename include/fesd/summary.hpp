@@ -101,6 +101,7 @@ struct StepProgress {
   int nlp_iterations = 0;
   double comp_residual = 0;
   Status status = Status::NotRun;  ///< of the step's last attempt
+  int run = 0;  ///< simulate(): which of its runs (1-based); 0: a plain integrate()
 };
 using StepCallback = std::function<void(const StepProgress&)>;
 /// Progress of a homotopy: one call per NLP solved (the OCP; re-solves included).
@@ -113,7 +114,8 @@ std::string homotopy_table_header();
 /// One row of the homotopy table, aligned with homotopy_table_header() (a pinned re-solve is
 /// marked as such).
 std::string format_homotopy_row(const HomotopyRow& r);
-/// "  step   12/40  t = 0.3  NLPs  5  iter   45  comp 1.2e-12  success\n"
+/// "  step   12/40  t = 0.3  NLPs  5  iter   45  comp 1.2e-12  success\n" ("  run 2  step ..."
+/// for a run of simulate())
 std::string format_step_progress(const StepProgress& p);
 /// The work and time lines every full report ends with: NLPs, iterations, pinned exits, wall
 /// time split into derivatives, IPOPT + MUMPS and setup. `per_step` > 0 adds per-step figures.

@@ -27,6 +27,7 @@
 #include <cstring>
 #include <exception>
 #include <filesystem>
+#include <functional>
 #include <iostream>
 #include <new>
 #include <stdexcept>
@@ -418,8 +419,12 @@ void print_header(const fesd::SimulationProblem& problem) {
   if (problem.u.size() > 0)
     out::print("  u           {}\n", join_vector(problem.u, problem.model.control_names));
   print_solver_header(std::to_string(o.discretization.N_FE), o.discretization, o.homotopy, o.nlp);
-  out::print("  simulation  T_sim = {:g}, N_sim = {} (step {:g})\n", problem.T_sim, problem.N_sim,
-             problem.N_sim > 0 ? problem.T_sim / problem.N_sim : 0.0);
+  fesd::AccuracyOptions accuracy;
+  accuracy.tol_sim = problem.tol_sim;
+  accuracy.N_sim = problem.N_sim;
+  accuracy.N_sim_max = problem.N_sim_max;
+  out::print("  simulation  T_sim = {:g}, {}\n", problem.T_sim,
+             fesd::format_accuracy_rule(accuracy, problem.T_sim));
   flush_stdout();
 }
 
@@ -604,9 +609,17 @@ Problem prepare(const SolveArgs& args, const CLI::App& cmd) {
 
 int run_simulate(const SolveArgs& args, const CLI::App& cmd) {
   const auto problem = prepare<fesd::SimulationProblem>(args, cmd);
-  const fesd::IntegratorResult result =
-      fesd::integrate(problem.model, problem.x0, problem.T_sim, problem.N_sim, problem.options,
-                      problem.u, problem.p);
+  // One progress line per run (N_sim chosen by tol_sim, or the companions of the estimate).
+  std::function<void(const fesd::AccuracyRun&)> on_run;
+  if (!args.quiet) {
+    const double tol = problem.tol_sim > 0  ? problem.tol_sim
+                       : problem.N_sim == 0 ? fesd::kDefaultTolSim
+                                            : 0.0;
+    on_run = [tol](const fesd::AccuracyRun& r) {
+      std::cerr << fesd::format_accuracy_run(r, tol) << std::flush;
+    };
+  }
+  const fesd::IntegratorResult result = fesd::simulate(problem, on_run);
   return finish(result, result.full_report(), problem.model, problem.name, args, cmd, "simulation");
 }
 

@@ -136,6 +136,15 @@ std::string sigma_N_at_most_sigma_0(const T& t, double sigma_N) {
   return fmt::format("must be <= sigma_0 = {}", sigma_0);
 }
 
+/// With a target, a given N_sim is the first step count tried: it must not exceed the cap.
+std::string N_sim_at_most_N_sim_max(const T& t, double N_sim) {
+  if (t.tol_sim == nullptr || t.N_sim_max == nullptr || !(*t.tol_sim > 0) || N_sim <= *t.N_sim_max)
+    return {};
+  return fmt::format(
+      "must be <= N_sim_max = {} (with tol_sim, N_sim is the first step count tried)",
+      *t.N_sim_max);
+}
+
 std::string ell_1_needs_terminal_constraints(const T& t, double mode) {
   if (static_cast<TerminalConstraint>(static_cast<int>(mode)) != TerminalConstraint::L1 ||
       t.ocp->n_g_terminal > 0)
@@ -163,8 +172,16 @@ std::vector<Option> build() {
   with(scalar<&T::T_sim>(kSim, "T_sim", Use::Simulation, "the length of the time interval", "T_sim",
                          kPositive),
        [](Option& x) { x.required = true; });
-  o.push_back(scalar<&T::N_sim>(kSim, "N_sim", Use::Simulation,
-                                "integration steps of length T_sim / N_sim", "N_sim", at_least(1)));
+  with(
+      scalar<&T::N_sim>(kSim, "N_sim", Use::Simulation, "integration steps of length T_sim / N_sim",
+                        "N_sim", at_least(0, "(0: chosen by tol_sim)")),
+      [](Option& x) { x.rule = N_sim_at_most_N_sim_max; });
+  o.push_back(scalar<&T::tol_sim>(
+      kSim, "tol_sim", Use::Simulation,
+      "target for the estimated error ||x(T_sim) - x_exact(T_sim)||, chooses N_sim", "",
+      at_least(0, "(0: 1e-6 if N_sim is not given, else no target)")));
+  o.push_back(scalar<&T::N_sim_max>(kSim, "N_sim_max", Use::Simulation,
+                                    "the largest N_sim tried to reach tol_sim", "", at_least(1)));
   o.push_back(input(kSim, "u", Use::Simulation,
                     "constant control values, one per control (comma-separated)", "", true));
   o.push_back(input(kSim, "t0", Use::Simulation,
@@ -516,11 +533,27 @@ std::vector<std::string> check(Table table, const OptionTarget& t) {
 }
 
 std::vector<std::string> validate_simulation(double T_sim, int N_sim, double t0) {
-  std::vector<std::string> e =
-      check(Table::Simulation, OptionTarget{.T_sim = &T_sim, .N_sim = &N_sim});
+  // integrate() takes a step count (the registry's N_sim = 0 means "chosen by simulate()").
+  std::vector<std::string> e = check(Table::Simulation, OptionTarget{.T_sim = &T_sim});
+  if (N_sim < 1) e.push_back(fmt::format("simulation.N_sim = {}: must be >= 1", N_sim));
   if (e.empty())  // the smallest step, docs/problem-files.md "Limits"
     if (std::string s =
             core::step_length_error("simulation.T_sim", T_sim, "simulation.N_sim", N_sim, t0);
+        !s.empty())
+      e.push_back(std::move(s));
+  return e;
+}
+
+std::vector<std::string> validate_simulation(double T_sim, int N_sim, double tol_sim, int N_sim_max,
+                                             double t0) {
+  std::vector<std::string> e = check(
+      Table::Simulation,
+      OptionTarget{.T_sim = &T_sim, .N_sim = &N_sim, .tol_sim = &tol_sim, .N_sim_max = &N_sim_max});
+  // The smallest step, docs/problem-files.md "Limits": of N_sim if given, else of one step (a
+  // search for tol_sim stops where the step would become shorter).
+  if (e.empty())
+    if (std::string s = core::step_length_error("simulation.T_sim", T_sim, "simulation.N_sim",
+                                                std::max(N_sim, 1), t0);
         !s.empty())
       e.push_back(std::move(s));
   return e;

@@ -44,6 +44,8 @@ struct OptionTarget {
   NlpOptions* nlp = nullptr;
   double* T_sim = nullptr;
   int* N_sim = nullptr;
+  double* tol_sim = nullptr;  ///< simulate()'s accuracy target (AccuracyOptions)
+  int* N_sim_max = nullptr;
   Ocp* ocp = nullptr;                 ///< [ocp] keys stored in the problem
   OcpOptions* ocp_options = nullptr;  ///< [ocp] keys stored in the solver options
 };
@@ -145,8 +147,12 @@ std::vector<std::string> check(Table table, const OptionTarget& t);
 
 /// The rules of integrate()'s time interval and number of steps, written once (the [simulation]
 /// ranges and the smallest step T_sim / N_sim, core::step_length_error, relative to the start
-/// time t0); used by integrate() and by simulation problem files.
+/// time t0); used by integrate(), which needs N_sim >= 1.
 std::vector<std::string> validate_simulation(double T_sim, int N_sim, double t0 = 0.0);
+/// The same for simulate() and simulation problem files, with its accuracy keys: N_sim = 0
+/// (chosen by tol_sim) allowed, tol_sim, N_sim_max.
+std::vector<std::string> validate_simulation(double T_sim, int N_sim, double tol_sim, int N_sim_max,
+                                             double t0);
 
 /// Messages joined by "; ".
 std::string join(const std::vector<std::string>& messages);

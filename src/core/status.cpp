@@ -9,6 +9,7 @@ std::string_view to_string(Status s) {
     case Status::ComplementarityNotMet: return "complementarity_not_met";
     case Status::NlpFailed: return "nlp_failed";
     case Status::EvaluationFailed: return "evaluation_failed";
+    case Status::ToleranceNotMet: return "tolerance_not_met";
   }
   return "unknown";
 }
@@ -21,6 +22,8 @@ std::string_view describe(Status s) {
       return "the homotopy ended with the complementarity residual above complementarity_tol";
     case Status::NlpFailed: return "IPOPT did not converge";
     case Status::EvaluationFailed: return "a model function returned NaN or inf";
+    case Status::ToleranceNotMet:
+      return "the error estimate did not reach tol_sim within N_sim_max steps";
   }
   return "unknown status";
 }

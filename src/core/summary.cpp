@@ -34,9 +34,9 @@ std::string format_homotopy_row(const HomotopyRow& r) {
 }
 
 std::string format_step_progress(const StepProgress& p) {
-  return fmt::format("  step {:>4}/{}  t = {:<10.6g}  NLPs {:>2}  iter {:>4}  comp {:.1e}  {}\n",
-                     p.step, p.N_sim, p.t, p.nlps, p.nlp_iterations, p.comp_residual,
-                     to_string(p.status));
+  return fmt::format("{}  step {:>4}/{}  t = {:<10.6g}  NLPs {:>2}  iter {:>4}  comp {:.1e}  {}\n",
+                     p.run > 0 ? fmt::format("  run {}", p.run) : "", p.step, p.N_sim, p.t, p.nlps,
+                     p.nlp_iterations, p.comp_residual, to_string(p.status));
 }
 
 std::string format_warnings(const Summary& s) {

@@ -552,6 +552,8 @@ std::string IntegratorResult::brief_report() const {
   os << fmt::format(", {} switch{}, {} NLPs, {} IPOPT iterations, {:.3f} s", switches.size(),
                     switches.size() == 1 ? "" : "es", summary.homotopy_steps,
                     summary.nlp_iterations, summary.wall_s);
+  if (!std::isnan(accuracy.error_estimate))
+    os << fmt::format(", error estimate {:.1e}", accuracy.error_estimate);
   return os.str();
 }
 
@@ -573,6 +575,7 @@ std::string IntegratorResult::full_report() const {
   const std::size_t n_steps = homotopy.size() - static_cast<std::size_t>(summary.refine_attempts) -
                               static_cast<std::size_t>(summary.split_steps);
   os << fmt::format("  integration steps    {}  ({} finite elements)\n", n_steps, h.size());
+  os << format_accuracy(accuracy);
   os << format_warnings(summary);
   os << format_work(summary, n_steps == 0 ? 1.0 : static_cast<double>(n_steps));
   return os.str();

@@ -65,6 +65,28 @@ json stats(const Summary& s) {
               {"warnings", s.warnings}};
 }
 
+json accuracy(const Accuracy& a) {
+  json runs = json::array();
+  for (const AccuracyRun& r : a.runs) {
+    runs.push_back(json{{"N_sim", r.N_sim},
+                        {"status", std::string(to_string(r.status))},
+                        {"x_final", array(r.x_final)},
+                        {"switch_times", array(r.switch_times)},
+                        {"error_estimate", number(r.error_estimate)},
+                        {"wall_s", number(r.wall_s)}});
+  }
+  return json{{"N_sim", a.N_sim},
+              {"tol_sim", number(a.tol_sim)},
+              {"met", a.met},
+              {"order", a.order},
+              {"consistent", a.consistent},
+              {"switch_times_consistent", a.switch_times_consistent},
+              {"noise_floor", number(a.noise_floor)},
+              {"at_noise_floor", a.at_noise_floor},
+              {"note", a.note},
+              {"runs", std::move(runs)}};
+}
+
 json switches(const std::vector<SwitchEvent>& events) {
   json a = json::array();
   for (const SwitchEvent& e : events) {
@@ -210,6 +232,9 @@ void write_json(const IntegratorResult& result, const Pss& model, const std::str
   j["h"] = array(result.h);
   j["switch_times"] = array(result.switch_times());
   j["x_final"] = array(result.x_final());
+  j["error_estimate"] = number(result.accuracy.error_estimate);
+  j["switch_time_estimate"] = number(result.accuracy.switch_time_estimate);
+  j["accuracy"] = accuracy(result.accuracy);
   j["stats"] = stats(result.summary);
   j["t_stage"] = array(result.t_stage);
   j["x_stage"] = rows(result.x_stage);

@@ -10,6 +10,8 @@ inline registry::OptionTarget target_of(SimulationProblem& q) {
   registry::OptionTarget t = registry::target_of(q.options);
   t.T_sim = &q.T_sim;
   t.N_sim = &q.N_sim;
+  t.tol_sim = &q.tol_sim;
+  t.N_sim_max = &q.N_sim_max;
   return t;
 }
 

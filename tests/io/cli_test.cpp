@@ -404,6 +404,45 @@ TEST(Cli, SimulateWritesRequestedOutputs) {
   EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 6);  // header + 5 boundaries
 }
 
+// Issue 13, 2: the header and `fesd check` state how N_sim is chosen and the error estimated;
+// simulate reports the estimate (progress: one line per run) and writes it to the JSON.
+TEST(Cli, SimulateCarriesAnErrorEstimate) {
+  ASSERT_TRUE(fs::exists(kOscillator)) << kOscillator << " is missing";
+  const CliRun given = run_cli({"check", kOscillator});
+  EXPECT_TRUE(contains(given.out,
+                       "  simulation  T_sim = 1.5708, N_sim = 100 (step 0.015708); error "
+                       "estimated from companion runs at N_sim = 50 and 25\n"))
+      << given.out;
+  const CliRun chosen = run_cli({"check", kOscillator, "--N_sim", "0"});
+  EXPECT_TRUE(contains(chosen.out,
+                       "N_sim chosen for tol_sim = 1e-06 (the default): runs from "
+                       "N_sim = 10 up to 1000 (N_sim_max)"))
+      << chosen.out;
+  const CliRun target = run_cli({"check", kOscillator, "--tol_sim", "1e-8", "--N_sim_max", "500"});
+  EXPECT_TRUE(contains(target.out,
+                       "N_sim chosen for tol_sim = 1e-08: runs from N_sim = 100 up "
+                       "to 500 (N_sim_max)"))
+      << target.out;
+
+  TempDir dir;
+  const std::string json = dir.file("r.json");
+  const CliRun r =
+      run_cli({"simulate", kOscillator, "--N_sim", "2", "--T_sim", "0.1", "--json", json});
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  for (const char* line : {"  run with N_sim = 2: success", "  run with N_sim = 4: success",
+                           "  run with N_sim = 8: success"})
+    EXPECT_TRUE(contains(r.err, line)) << r.err;
+  EXPECT_TRUE(contains(r.err, "  run 3  step    8/8")) << r.err;  // steps numbered by run
+  EXPECT_TRUE(contains(r.out, "  error estimate       ")) << r.out;
+  EXPECT_TRUE(contains(r.out, "  runs                 N_sim = 2, 4, 8  (")) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(read_file(json));
+  ASSERT_TRUE(j["error_estimate"].is_number()) << j["error_estimate"];
+  EXPECT_GT(j["error_estimate"].get<double>(), 0.0);
+  EXPECT_EQ(j["accuracy"]["N_sim"], 2);
+  EXPECT_EQ(j["accuracy"]["runs"].size(), 3u);
+  EXPECT_EQ(j["t"].size(), 5u);  // the result is the run asked for: 2 steps, 2 elements each
+}
+
 // REAL SOLVE: one IPOPT iteration per NLP cannot converge: exit 1, and the outputs are written.
 TEST(Cli, NumericalFailureExits1AndStillWrites) {
   ASSERT_TRUE(fs::exists(kOscillator)) << kOscillator << " is missing";

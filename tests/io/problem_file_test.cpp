@@ -222,7 +222,9 @@ TEST(ProblemFile, DefaultsWhenTablesAreAbsent) {
   EXPECT_EQ(q.name, "minimal");  // the file stem
   EXPECT_EQ(q.source, "dir/minimal.toml");
   EXPECT_TRUE(q.description.empty());
-  EXPECT_EQ(q.N_sim, 1);
+  EXPECT_EQ(q.N_sim, 0);      // chosen by simulate() for tol_sim
+  EXPECT_EQ(q.tol_sim, 0.0);  // the default kDefaultTolSim applies
+  EXPECT_EQ(q.N_sim_max, 1000);
   EXPECT_EQ(q.T_sim, 1.0);
   EXPECT_EQ(q.u.size(), 0);
   EXPECT_EQ(q.p.size(), 0);
