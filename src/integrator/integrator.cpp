@@ -157,8 +157,7 @@ class Integrator {
         p_(std::move(p)),
         levels_(kMaxSplit + 1),
         x_(x0),
-        settings_cannot_reach_(final_sigma(options.homotopy) >
-                               options.homotopy.complementarity_tol) {
+        settings_cannot_reach_(!warnings(options.homotopy).empty()) {
     res_.summary.warnings = warnings(options.homotopy);
     // Initial guess of the first step: the LP at x0 (then the last stage of the step before).
     guess_ = dcs::solve_lp(model_, x0, p_);
@@ -259,6 +258,10 @@ class Integrator {
     const std::size_t first_switch = res_.switches.size();
     const double t_step = t_;
     accept(*solved);
+    // An exit at the end of the step before, whose pin failed there, is recorded here (the switch
+    // at a step boundary belongs to the step that starts at it).
+    if (!carried_unlocated_.empty()) mark_switches(first_switch, carried_unlocated_);
+    carried_unlocated_ = unlocated;
     if (!unlocated.empty()) mark_unlocated(first_switch, t_step, unlocated);
     return true;
   }
@@ -362,18 +365,23 @@ class Integrator {
   /// Marks the exits among the switches from index `first` on (those of the step that started at
   /// t_step) whose region could not be pinned, and says so in the summary's warnings.
   void mark_unlocated(std::size_t first, double t_step, const std::vector<int>& regions) {
-    using discretization::FesdInterval;
-    for (std::size_t i = first; i < res_.switches.size(); ++i) {
-      SwitchEvent& s = res_.switches[i];
-      for (int r : FesdInterval::exit_regions(model_, s.before, s.after))
-        if (std::find(regions.begin(), regions.end(), r) != regions.end()) s.located = false;
-    }
+    mark_switches(first, regions);
     res_.summary.warnings.push_back(fmt::format(
         "the sliding exit{} of region{} {} in the step from t = {:.6g} could not be located (the "
         "re-solve with the exit pinned failed): its switch time may be off by up to one element "
         "length, {:.3g}; try another N_sim",
         regions.size() == 1 ? "" : "s", regions.size() == 1 ? "" : "s", fmt::join(regions, ", "),
         t_step, T_step_ / d_.N_FE));
+  }
+
+  /// Sets located = false on the switches from index `first` on that are exits of `regions`.
+  void mark_switches(std::size_t first, const std::vector<int>& regions) {
+    using discretization::FesdInterval;
+    for (std::size_t i = first; i < res_.switches.size(); ++i) {
+      SwitchEvent& s = res_.switches[i];
+      for (int r : FesdInterval::exit_regions(model_, s.before, s.after))
+        if (std::find(regions.begin(), regions.end(), r) != regions.end()) s.located = false;
+    }
   }
 
   /// The previous step ended sliding with theta_r > 0 (guess_.theta: its last stage), and this
@@ -517,6 +525,7 @@ class Integrator {
   mpcc::HomotopyResult last_;            // of the last attempt
   const StepProblem* failed_ = nullptr;  // the last failed attempt
   const bool settings_cannot_reach_;     // the homotopy's last sigma > complementarity_tol
+  std::vector<int> carried_unlocated_;   // unpinned exits of the step before
 };
 
 }  // namespace
