@@ -423,8 +423,9 @@ void print_header(const fesd::SimulationProblem& problem) {
   accuracy.tol_sim = problem.tol_sim;
   accuracy.N_sim = problem.N_sim;
   accuracy.N_sim_max = problem.N_sim_max;
-  out::print("  simulation  T_sim = {:g}, {}\n", problem.T_sim,
-             fesd::format_accuracy_rule(accuracy, problem.T_sim));
+  out::print("  simulation  T_sim = {:g}, {}; fix_active_set = {}\n", problem.T_sim,
+             fesd::format_accuracy_rule(accuracy, problem.T_sim),
+             yes_no(o.homotopy.fix_active_set));
   flush_stdout();
 }
 

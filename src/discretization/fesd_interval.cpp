@@ -527,9 +527,17 @@ void FesdInterval::set_guess(std::vector<double>& w, const Eigen::VectorXd& x0,
   update_lifted_guess(w);
 }
 
+namespace {
+// The activity rule, for one stage or summed over an element's stages: theta outweighs |lambda|
+// and is above noise somewhere (kActiveThetaTol).
+bool theta_outweighs(double theta_sum, double abs_lambda_sum, double theta_max) {
+  return theta_sum > abs_lambda_sum && theta_max > FesdInterval::kActiveThetaTol;
+}
+}  // namespace
+
 bool FesdInterval::stage_active(const double* w, int n, int m, int r) const {
   const double th = w[theta(n, m, r)];
-  return th > std::max(std::abs(w[lambda(n, m, r)]), kActiveThetaTol);
+  return theta_outweighs(th, std::abs(w[lambda(n, m, r)]), th);
 }
 
 std::vector<int> FesdInterval::active_set(const double* w, int n) const {
@@ -541,7 +549,7 @@ std::vector<int> FesdInterval::active_set(const double* w, int n) const {
       th_max = std::max(th_max, w[theta(n, s, r)]);
       la += std::abs(w[lambda(n, s, r)]);
     }
-    if (th > la && th_max > kActiveThetaTol) active.push_back(r);
+    if (theta_outweighs(th, la, th_max)) active.push_back(r);
   }
   return active;
 }

@@ -156,9 +156,9 @@ class Integrator {
         u_(std::move(u)),
         p_(std::move(p)),
         levels_(kMaxSplit + 1),
-        x_(x0),
-        settings_cannot_reach_(!warnings(options.homotopy).empty()) {
+        x_(x0) {
     res_.summary.warnings = warnings(options.homotopy);
+    settings_cannot_reach_ = !res_.summary.warnings.empty();
     // Initial guess of the first step: the LP at x0 (then the last stage of the step before).
     guess_ = dcs::solve_lp(model_, x0, p_);
     guess_xdot_ = xdot_at(x0, guess_.theta);
@@ -524,7 +524,7 @@ class Integrator {
   bool careful_ = false;                 // an attempt of the current step failed
   mpcc::HomotopyResult last_;            // of the last attempt
   const StepProblem* failed_ = nullptr;  // the last failed attempt
-  const bool settings_cannot_reach_;     // the homotopy's last sigma > complementarity_tol
+  bool settings_cannot_reach_ = false;   // the homotopy's last sigma > complementarity_tol
   std::vector<int> carried_unlocated_;   // unpinned exits of the step before
 };
 

@@ -411,7 +411,7 @@ TEST(Cli, SimulateCarriesAnErrorEstimate) {
   const CliRun given = run_cli({"check", kOscillator});
   EXPECT_TRUE(contains(given.out,
                        "  simulation  T_sim = 1.5708, N_sim = 100 (step 0.015708); error "
-                       "estimated from companion runs at N_sim = 50 and 25\n"))
+                       "estimated from companion runs at N_sim = 50 and 25; fix_active_set = 1\n"))
       << given.out;
   const CliRun chosen = run_cli({"check", kOscillator, "--N_sim", "0"});
   EXPECT_TRUE(contains(chosen.out,
