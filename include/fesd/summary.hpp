@@ -87,6 +87,15 @@ struct Summary {
   /// Re-solves with pinned exits that failed; those solutions stay unpinned and their exits are
   /// marked SwitchEvent::located = false.
   int pin_failures = 0;
+  // ---- switches held by the grid (OCP; docs/formulation.md, "Switches held by the grid") ----
+  /// Re-solves from a re-gridded solution (a switch held by the bounds of h_n moved into the
+  /// middle of its range) that were kept: they converged and did not raise the cost.
+  int grid_moves = 0;
+  /// Re-solves from a probe of a touch (a switch born where the solution touched a switching
+  /// surface) that were kept: they converged and lowered the cost.
+  int born_switches = 0;
+  /// Switches still held by an h_n bound in the result (each also named in `warnings`).
+  int held_switches = 0;
   /// What the user should know about the result although it succeeded (settings that cannot
   /// reach complementarity_tol, switch times that could not be located), one sentence each.
   std::vector<std::string> warnings = {};

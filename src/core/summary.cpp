@@ -74,6 +74,12 @@ std::string format_work(const Summary& s, double per_step) {
   if (s.pinned_exits > 0 || s.pin_failures > 0)
     out += fmt::format("  pinned sliding exits {}  ({} re-solve{} failed, unpinned)\n",
                        s.pinned_exits, s.pin_failures, s.pin_failures == 1 ? "" : "s");
+  if (s.grid_moves > 0 || s.held_switches > 0)
+    out += fmt::format("  grid moves           {}  ({} switch{} still held by an h bound)\n",
+                       s.grid_moves, s.held_switches, s.held_switches == 1 ? "" : "es");
+  if (s.born_switches > 0)
+    out += fmt::format("  born switches        {}  (probed at a touch of a switching surface)\n",
+                       s.born_switches);
   out += fmt::format("  wall time            {:.3f} s", s.wall_s);
   out += per_step > 0 ? fmt::format("  ({:.2f} ms per step)\n", 1e3 * s.wall_s / per_step) : "\n";
   const double busy = s.derivative_s + s.solver_s;

@@ -598,8 +598,9 @@ std::vector<FesdInterval::ExitPin> FesdInterval::exits_to_pin(const double* w,
 
 std::vector<nlp::Bound> FesdInterval::pin_bounds(const double* w,
                                                  const std::vector<ExitPin>& pins) const {
-  if (!can_pin_exits())
-    throw InternalError("FesdInterval::pin_bounds needs FESD with a stiffly accurate scheme");
+  if (!opt_.use_fesd || (!pins.empty() && !can_pin_exits()))
+    throw InternalError(
+        "FesdInterval::pin_bounds needs FESD (and a stiffly accurate scheme to pin exits)");
   // The active sets to fix: the solution's, with each pinned exit's region kept in its element
   // and (theta_zero) removed from the next.
   std::vector<std::vector<int>> active(N_FE_);
@@ -611,6 +612,16 @@ std::vector<nlp::Bound> FesdInterval::pin_bounds(const double* w,
     }
     if (pin.theta_zero && pin.n + 1 < N_FE_) std::erase(active[pin.n + 1], pin.r);
   }
+  std::vector<nlp::Bound> bounds = active_set_bounds(active);
+  for (const ExitPin& pin : pins)
+    if (pin.theta_zero) bounds.push_back({theta(pin.n, n_s_ - 1, pin.r), 0.0, 0.0});
+  return bounds;
+}
+
+std::vector<nlp::Bound> FesdInterval::active_set_bounds(
+    const std::vector<std::vector<int>>& active) const {
+  if (!opt_.use_fesd || static_cast<int>(active.size()) != N_FE_)
+    throw InternalError("FesdInterval::active_set_bounds needs FESD and one set per element");
   // The interval's own lambda_{0,0} (lp_at_start) is tied to the fixed start state s0 by the LP
   // (9). With every region of a sliding mode fixed to lambda = 0 there, g_r(s0) - mu = 0 for
   // each of them repeats c(s0) = 0, an equation too many (s0 is given): the Jacobian loses rank
@@ -647,8 +658,6 @@ std::vector<nlp::Bound> FesdInterval::pin_bounds(const double* w,
           bounds.push_back({points_[n][q][r], 0.0, 0.0});
       }
     }
-  for (const ExitPin& pin : pins)
-    if (pin.theta_zero) bounds.push_back({theta(pin.n, n_s_ - 1, pin.r), 0.0, 0.0});
   return bounds;
 }
 

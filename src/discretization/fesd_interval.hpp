@@ -156,13 +156,60 @@ class FesdInterval {
   /// constraints then hold exactly and the re-solve is a smooth problem in h and the stage
   /// values, the square system of Thm 15 plus the free element lengths. Fixing only the pinned
   /// exits left IPOPT to wander between degenerate complementarity branches (the belt of
-  /// docs/formulation.md: converged to local infeasibility).
+  /// docs/formulation.md: converged to local infeasibility). Any FESD scheme without pins (the
+  /// active set fixed only); pins need can_pin_exits().
   std::vector<nlp::Bound> pin_bounds(const double* w, const std::vector<ExitPin>& pins) const;
+  /// The bounds that fix the given active set of every element (one sorted list per element):
+  /// the part of pin_bounds() without pins.
+  std::vector<nlp::Bound> active_set_bounds(const std::vector<std::vector<int>>& active) const;
   /// Between two integration steps an exit is pinned only when theta of the leaving region at
   /// the end of the step before exceeds this and its lambda there (below it the exit is early by
   /// ~ theta / |d theta / dt|, an error ~1e-12 in the state); else the first element would have
   /// to slide on without the region and shrink to length 0.
   static constexpr double kExitThetaTol = 1e-6;
+  // ---- switches held by the grid (issue 14; docs/formulation.md, "Switches held by the grid")
+  // Cross complementarity puts every switch on an element boundary, and a boundary can move only
+  // as far as the lengths of its neighbouring elements allow: h_n in [(1 - gamma_h) h0,
+  // (1 + gamma_h) h0] (59f). An optimizer that moves a switch (an OCP's) can carry it to the end
+  // of that range and stop there, at a point that is stationary for the discretized MPCC but not
+  // for the OCP: moving on needs the switch to change boundaries, through an element of length 0.
+
+  /// Boundaries n (1..N_FE-1) where the active set (active_set()) changes at w, with the
+  /// interval's start (0) and end (N_FE) first and last: the segments of constant active set are
+  /// the elements between two consecutive entries. A segment of length ~0 (elements collapsed at
+  /// a switch) is joined to the segment after it (the last to the one before).
+  std::vector<int> segment_boundaries(const double* w) const;
+  /// The switches of w held by the grid: interior boundaries n where the active set changes and
+  /// every element of a neighbouring segment (the elements up to the previous switch or the
+  /// interval start, or up to the next switch or the interval end) has h_n at a bound (within
+  /// kHeldTol h0).
+  std::vector<int> held_switches(const double* w) const;
+  static constexpr double kHeldTol = 1e-6;
+  /// Re-places the element boundaries of the interval for the switches of w_old: every segment
+  /// (segment_boundaries()) keeps its length and gets a number of elements in proportion to it
+  /// (at least one), all of equal length, so each switch lies on a boundary that can move both
+  /// ways. The guess of each new element is the old solution on the same segment: states from
+  /// the stage polynomial of the old element that contains the new stage time, V, theta,
+  /// lambda, mu copied from it (the active set is unchanged). Writes the interval's variables of
+  /// w_new (the rest stays). False (w_new unchanged) if it cannot: more segments than elements,
+  /// or a segment whose uniform h would leave the bounds of h.
+  bool regrid(const double* w_old, std::vector<double>& w_new) const;
+  /// A touch: at boundary n (0..N_FE-1, the start of element n) the state lies on the boundary of
+  /// region r (lambda_r at that point <= kTouchTol) while r is active neither in element n nor
+  /// (n > 0) in element n-1, and `instead` is the one active region of r's subsystem in element
+  /// n. The solution is then at a kink of the problem (e.g. an OCP's free x0 on a switching
+  /// surface) where a switch could be born that the MPCC's stationarity conditions do not see.
+  struct Touch {
+    int n = 0, r = 0, instead = 0;
+  };
+  std::vector<Touch> touches(const double* w) const;
+  static constexpr double kTouchTol = 1e-7;
+  /// The probe of a touch: the active sets of w with element t.n in region t.r instead of
+  /// t.instead (the switch born at boundary t.n + 1), and the guess `w_new` with theta moved to
+  /// the new region in that element.
+  std::vector<std::vector<int>> probe(const double* w, const Touch& t,
+                                      std::vector<double>& w_new) const;
+
   /// Recomputes the lifted sums of step equilibration (if any) in the guess w from its other
   /// entries; call after changing the guess of lambda or theta.
   void update_lifted_guess(std::vector<double>& w) const;

@@ -62,6 +62,9 @@ json stats(const Summary& s) {
               {"rescued_steps", s.rescued_steps},
               {"pinned_exits", s.pinned_exits},
               {"pin_failures", s.pin_failures},
+              {"grid_moves", s.grid_moves},
+              {"born_switches", s.born_switches},
+              {"held_switches", s.held_switches},
               {"warnings", s.warnings}};
 }
 

@@ -163,11 +163,17 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
 }
 
 HomotopyResult Problem::solve_again(nlp::NlpSolver& solver, const HomotopyOptions& o,
-                                    const std::vector<nlp::Bound>& changes, int pinned_exits) {
+                                    const std::vector<nlp::Bound>& changes, int pinned_exits,
+                                    const std::vector<double>* start) {
   if (it_.x.empty()) throw InternalError("mpcc::Problem::solve_again(): no homotopy before");
   HomotopyResult res;
   const std::vector<double> x_lb = nlp_.x_lb, x_ub = nlp_.x_ub;
   nlp::Iterate trial = it_;
+  if (start != nullptr) {
+    if (start->size() != trial.x.size())
+      throw InternalError("mpcc::Problem::solve_again(): start point of the wrong size");
+    trial.x = *start;
+  }
   for (const nlp::Bound& c : changes) {
     nlp_.x_lb[c.var] = c.lb;
     nlp_.x_ub[c.var] = c.ub;

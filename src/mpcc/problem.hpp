@@ -111,11 +111,16 @@ class Problem {
   /// e.g. sliding exits pinned, then restores the bounds. The point is moved into the new bounds
   /// first. One row, numbered after the homotopy's, with `pinned_exits` as given. Success when it
   /// converges with a complementarity residual <= complementarity_tol; then solution() is the
-  /// new point, otherwise it stays the homotopy's.
+  /// new point, otherwise it stays the homotopy's. `start` (if given) replaces the primal point
+  /// of the warm start (the duals stay): a re-gridded solution (FesdInterval::regrid).
   HomotopyResult solve_again(nlp::NlpSolver& solver, const HomotopyOptions& options,
-                             const std::vector<nlp::Bound>& changes, int pinned_exits = 0);
+                             const std::vector<nlp::Bound>& changes, int pinned_exits = 0,
+                             const std::vector<double>* start = nullptr);
   /// The last solution (the last iterate of the last solve; empty before the first).
   const std::vector<double>& solution() const { return it_.x; }
+  /// The last primal-dual iterate, and putting one back (a re-solve whose result is rejected).
+  const nlp::Iterate& iterate() const { return it_; }
+  void restore(nlp::Iterate it) { it_ = std::move(it); }
 
  private:
   nlp::BlockNlp nlp_;

@@ -418,6 +418,132 @@ void extract(const OcpNlp& b, const Ocp& ocp, const std::vector<double>& w,
   res.objective = objective;
 }
 
+/// The OCP's own cost (59a) at the NLP point w.
+double cost(const OcpNlp& b, const Ocp& ocp, const std::vector<double>& w,
+            const Eigen::VectorXd& p) {
+  OcpResult r;
+  extract(b, ocp, w, p, r);
+  return r.objective;
+}
+
+/// Switches held by the grid (docs/formulation.md, "Switches held by the grid"): while the
+/// solution has a switch on an element boundary whose neighbouring elements sit at an h bound,
+/// re-place the boundaries of those intervals (FesdInterval::regrid) and solve the last NLP from
+/// there with every element's active set fixed (a smooth problem in which the switch moves
+/// freely again). A round is kept if it converges and does not raise the cost; at most
+/// kMaxGridMoves rounds (each one at least doubles how far a held switch can go). Switches still
+/// held at the end are counted and named in a warning.
+template <class Account>
+void move_held_switches(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Eigen::VectorXd& p,
+                        nlp::NlpSolver& solver, const Account& account, mpcc::HomotopyResult& hr,
+                        Summary& summary) {
+  constexpr int kMaxGridMoves = 8;
+  mpcc::Problem& mp = b.mpcc;
+  auto held_count = [&](const std::vector<double>& w) {
+    int n = 0;
+    for (const auto& iv : b.iv) n += static_cast<int>(iv->held_switches(w.data()).size());
+    return n;
+  };
+  for (int round = 0; round < kMaxGridMoves && held_count(mp.solution()) > 0; ++round) {
+    const std::vector<double> w = mp.solution();
+    std::vector<double> moved = w;
+    bool any = false;
+    for (const auto& iv : b.iv)
+      if (!iv->held_switches(w.data()).empty()) any = iv->regrid(w.data(), moved) || any;
+    if (!any) break;
+    std::vector<nlp::Bound> bounds;
+    int n_pins = 0;
+    for (const auto& iv : b.iv) {
+      std::vector<FesdInterval::ExitPin> pins;
+      if (o.discretization.pin_sliding_exits && iv->can_pin_exits())
+        pins = iv->exits_to_pin(moved.data(), /*control_jump_at_end=*/true);
+      n_pins += static_cast<int>(pins.size());
+      for (const nlp::Bound& bd : iv->pin_bounds(moved.data(), pins)) bounds.push_back(bd);
+    }
+    const double cost_before = cost(b, ocp, w, p);
+    const nlp::Iterate before = mp.iterate();
+    const mpcc::HomotopyResult again = mp.solve_again(solver, o.homotopy, bounds, n_pins, &moved);
+    if (o.on_homotopy_row) o.on_homotopy_row(again.rows.back());
+    account(again);
+    const bool kept =
+        again.status == Status::Success &&
+        cost(b, ocp, mp.solution(), p) <= cost_before + 1e-9 * std::max(1.0, std::abs(cost_before));
+    if (!kept) {
+      mp.restore(before);
+      break;
+    }
+    ++summary.grid_moves;
+    hr.comp_residual = again.comp_residual;
+  }
+}
+
+/// Switches born at a touch (docs/formulation.md, "Switches held by the grid"): where the
+/// solution touches a switching surface at an element boundary without switching (an OCP's free
+/// x0 on the surface, a trajectory grazing it), the MPCC's stationarity conditions do not see the
+/// switch that could be born there, and the homotopy stops at the kink. Each touch
+/// (FesdInterval::touches) is probed: the element after it in the other region, solved with
+/// every active set fixed; kept if the cost falls, then held switches are moved again. At most
+/// kMaxProbes NLPs.
+template <class Account>
+void probe_touches(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Eigen::VectorXd& p,
+                   nlp::NlpSolver& solver, const Account& account, mpcc::HomotopyResult& hr,
+                   Summary& summary) {
+  constexpr int kMaxProbes = 4;
+  mpcc::Problem& mp = b.mpcc;
+  int probes = 0;
+  bool improved = true;
+  while (improved && probes < kMaxProbes) {
+    improved = false;
+    const std::vector<double> w = mp.solution();
+    const double cost_before = cost(b, ocp, w, p);
+    for (std::size_t k = 0; k < b.iv.size() && !improved && probes < kMaxProbes; ++k) {
+      for (const FesdInterval::Touch& t : b.iv[k]->touches(w.data())) {
+        if (probes >= kMaxProbes) break;
+        ++probes;
+        std::vector<double> start = w;
+        const auto active = b.iv[k]->probe(w.data(), t, start);
+        std::vector<nlp::Bound> bounds;
+        for (std::size_t j = 0; j < b.iv.size(); ++j)
+          for (const nlp::Bound& bd :
+               j == k ? b.iv[j]->active_set_bounds(active) : b.iv[j]->pin_bounds(start.data(), {}))
+            bounds.push_back(bd);
+        const nlp::Iterate before = mp.iterate();
+        const mpcc::HomotopyResult again = mp.solve_again(solver, o.homotopy, bounds, 0, &start);
+        if (o.on_homotopy_row) o.on_homotopy_row(again.rows.back());
+        account(again);
+        if (again.status == Status::Success &&
+            cost(b, ocp, mp.solution(), p) <
+                cost_before - 1e-9 * std::max(1.0, std::abs(cost_before))) {
+          ++summary.born_switches;
+          hr.comp_residual = again.comp_residual;
+          improved = true;
+          break;
+        }
+        mp.restore(before);
+      }
+    }
+    if (improved) move_held_switches(b, ocp, o, p, solver, account, hr, summary);
+  }
+}
+
+/// Counts the switches still held by the grid and names each in a warning.
+void report_held_switches(const OcpNlp& b, const std::vector<double>& w, Summary& summary) {
+  double t0 = 0;
+  for (const auto& iv : b.iv) {
+    for (int n : iv->held_switches(w.data())) {
+      double t = t0;
+      for (int e = 0; e < n; ++e) t += w[iv->h(e)];
+      ++summary.held_switches;
+      summary.warnings.push_back(fmt::format(
+          "the switch at t = {:.6g} is held by the grid: the element lengths next to it are at "
+          "their bounds (1 +- gamma_h) h, so the optimizer may have stopped it short of the "
+          "optimum (use more finite elements, or a larger gamma_h)",
+          t));
+    }
+    for (int e = 0; e < iv->N_FE(); ++e) t0 += w[iv->h(e)];
+  }
+}
+
 }  // namespace
 
 namespace ocp_detail {
@@ -526,6 +652,11 @@ OcpResult solve(const Ocp& ocp, const OcpOptions& options) {
             n_pins, n_pins == 1 ? "" : "s", n_pins == 1 ? "its" : "their", n_pins == 1 ? "" : "s"));
       }
     }
+  }
+  if (hr.status == Status::Success && options.discretization.use_fesd) {
+    move_held_switches(*b, ocp, options, p, *solver, account, hr, res.summary);
+    probe_touches(*b, ocp, options, p, *solver, account, hr, res.summary);
+    report_held_switches(*b, mp.solution(), res.summary);
   }
   res.status = hr.status;
   res.comp_residual = hr.comp_residual;
