@@ -574,7 +574,9 @@ std::vector<FesdInterval::ExitPin> FesdInterval::exits_to_pin(const double* w,
   std::vector<std::vector<int>> active(N_FE_);
   for (int n = 0; n < N_FE_; ++n) active[n] = active_set(w, n);
   for (int n = 0; n + 1 < N_FE_; ++n)
-    for (int r : exit_regions(model_, active[n], active[n + 1])) pins.push_back({n, r, true});
+    // (an element of length ~0 with both regions active is a crossing, not a sliding mode)
+    if (w[h(n)] > kHeldTol * in_.T / N_FE_)
+      for (int r : exit_regions(model_, active[n], active[n + 1])) pins.push_back({n, r, true});
   // An exit inside the last element: r slides there and has left the surface by its end.
   const int last = N_FE_ - 1;
   for (int k = 0; k < model_.n_sys(); ++k) {

@@ -182,7 +182,7 @@ class FesdInterval {
   /// The switches of w held by the grid: interior boundaries n where the active set changes and
   /// every element of a neighbouring segment (the elements up to the previous switch or the
   /// interval start, or up to the next switch or the interval end) has h_n at a bound (within
-  /// kHeldTol h0).
+  /// kHeldTol h0; at the same bound, or some collapsed and the others at the upper bound).
   std::vector<int> held_switches(const double* w) const;
   static constexpr double kHeldTol = 1e-6;
   /// Re-places the element boundaries of the interval for the switches of w_old: every segment
@@ -194,7 +194,8 @@ class FesdInterval {
   /// w_new (the rest stays). False (w_new unchanged) if it cannot: more segments than elements,
   /// or a segment whose uniform h would leave the bounds of h.
   bool regrid(const double* w_old, std::vector<double>& w_new) const;
-  /// A touch: at boundary n (0..N_FE-1, the start of element n) the state lies on the boundary of
+  /// A touch: at boundary n (0..N_FE-1, the start of element n, of positive length; collapsed
+  /// elements before it are skipped) the state lies on the boundary of
   /// region r (lambda_r at that point <= kTouchTol) while r is active neither in element n nor
   /// (n > 0) in element n-1, and `instead` is the one active region of r's subsystem in element
   /// n. The solution is then at a kink of the problem (e.g. an OCP's free x0 on a switching

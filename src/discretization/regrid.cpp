@@ -42,13 +42,13 @@ std::vector<int> FesdInterval::held_switches(const double* w) const {
   if (!opt_.use_fesd) return held;
   const double h0 = in_.T / N_FE_, tol = kHeldTol * h0;
   const double lb = (1.0 - opt_.gamma_h) * h0, ub = (1.0 + opt_.gamma_h) * h0;
-  auto at_bound = [&](int first, int end) {  // every element of [first, end) at one bound
-    bool all_lb = true, all_ub = true;
-    for (int n = first; n < end; ++n) {
-      all_lb = all_lb && w[h(n)] <= lb + tol;
-      all_ub = all_ub && w[h(n)] >= ub - tol;
-    }
-    return all_lb || all_ub;
+  // Every element of [first, end) at a bound: all at the same one (the segment cannot grow, or
+  // cannot shrink), or a mix, such as a collapsed element next to one at the upper bound, which
+  // the step-equilibration penalty keeps from evening out.
+  auto at_bound = [&](int first, int end) {
+    for (int n = first; n < end; ++n)
+      if (w[h(n)] > lb + tol && w[h(n)] < ub - tol) return false;
+    return true;
   };
   const std::vector<int> b = segment_boundaries(w);
   for (std::size_t j = 1; j + 1 < b.size(); ++j)
@@ -174,8 +174,13 @@ std::vector<FesdInterval::Touch> FesdInterval::touches(const double* w) const {
   auto contains = [](const std::vector<int>& a, int r) {
     return std::find(a.begin(), a.end(), r) != a.end();
   };
+  const double tol = kHeldTol * in_.T / N_FE_;
+  int prev = -1;  // the last element before n of positive length
   for (int n = 0; n < N_FE_; ++n) {
-    if (n > 0 && active[n] != active[n - 1]) continue;   // a switch, not a touch
+    if (w[h(n)] <= tol) continue;  // collapsed: its start point is that of the next element
+    const bool switch_here = prev >= 0 && active[n] != active[prev];
+    prev = n;
+    if (switch_here) continue;                           // a switch, not a touch
     const std::vector<int>& point = points_[n].front();  // lambda at the start of element n
     for (int k = 0; k < model_.n_sys(); ++k) {
       const int first = model_.region_offset(k), end = model_.region_offset(k + 1);
@@ -201,6 +206,15 @@ std::vector<std::vector<int>> FesdInterval::probe(const double* w, const Touch& 
   for (int s = 0; s < n_s_; ++s) {
     w_new[theta(t.n, s, t.r)] = w[theta(t.n, s, t.instead)];
     w_new[theta(t.n, s, t.instead)] = 0.0;
+  }
+  // Collapsed elements right before the touch (length ~0, e.g. both regions active at a free x0
+  // on the surface) are part of it: they take the new set too, or they would hold the state on
+  // the surface.
+  const double tol = kHeldTol * in_.T / N_FE_;
+  for (int n = t.n - 1; n >= 0 && w[h(n)] <= tol; --n) {
+    active[n] = a;
+    for (int s = 0; s < n_s_; ++s)
+      for (int r = 0; r < model_.n_theta(); ++r) w_new[theta(n, s, r)] = w_new[theta(t.n, s, r)];
   }
   update_lifted_guess(w_new);
   return active;

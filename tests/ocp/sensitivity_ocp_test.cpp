@@ -60,4 +60,48 @@ TEST(SensitivityStandard, FixedSigmaStallsNearTheGuess) {
   EXPECT_GT(std::abs(r.x0()[0] - kSensitivityX0Star), 0.5);
 }
 
+// Issue 14, item 1: with the default OcpOptions the homotopy alone stopped with the switch held
+// by the grid (x0 = -0.48, -0.96: elements next to it at h = 2 h0) or at the kink x0 = 0 (the
+// free x0 on the switching surface). Moving held switches and probing touches reaches x0* from
+// each of these guesses (each failed before; bench/ocp_robustness has the whole table).
+struct DefaultCase {
+  fesd::RkScheme scheme;
+  int n_s, N_FE;
+  fesd::OcpInitialization init;
+  double guess;
+};
+class SensitivityDefaults : public ::testing::TestWithParam<DefaultCase> {};
+
+TEST_P(SensitivityDefaults, ReachesTheTrueMinimizer) {
+  const DefaultCase c = GetParam();
+  fesd::OcpOptions o;
+  o.discretization.rk_scheme = c.scheme;
+  o.discretization.n_s = c.n_s;
+  o.discretization.N_FE = c.N_FE;
+  o.initialization = c.init;
+  const fesd::OcpResult r = fesd::solve(sensitivity_ocp(c.guess), o);
+  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+  EXPECT_NEAR(r.x0()[0], kSensitivityX0Star, 1e-6);
+  EXPECT_NEAR(r.objective, kSensitivityVStar, 1e-8);
+  EXPECT_EQ(r.summary.held_switches, 0);
+  EXPECT_GE(r.summary.grid_moves + r.summary.born_switches, 1);  // the homotopy alone stopped
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Grid, SensitivityDefaults,
+    ::testing::Values(
+        // held at -0.96 (two elements at 2 h0 before the switch, one collapsed)
+        DefaultCase{fesd::RkScheme::GaussLegendre, 2, 25, fesd::OcpInitialization::Constant,
+                    1.1379310344827587},
+        // stopped at the kink x0 = 0
+        DefaultCase{fesd::RkScheme::GaussLegendre, 2, 25, fesd::OcpInitialization::Constant,
+                    0.3103448275862069},
+        // x0 = 0 with a collapsed first element holding both regions
+        DefaultCase{fesd::RkScheme::GaussLegendre, 3, 25, fesd::OcpInitialization::Constant,
+                    0.10344827586206896},
+        DefaultCase{fesd::RkScheme::LobattoIIIC, 3, 10, fesd::OcpInitialization::Constant,
+                    1.7586206896551724},
+        DefaultCase{fesd::RkScheme::GaussLegendre, 2, 25, fesd::OcpInitialization::Simulation,
+                    -0.3103448275862069}));
+
 }  // namespace
