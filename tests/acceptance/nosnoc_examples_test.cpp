@@ -219,10 +219,11 @@ TEST(NosnocCartPole, ReachesNosnocPysObjective) {
 
 // ---- Motor with friction (OCP) -----------------------------------------------------------------
 // The file's settings (30 stages x 2 FE, comp_tol 1e-6, l2_relaxed for nosnoc_py's
-// L2_RELAXED_SCALED) give fesd's earlier J = 0.85396 (measured 0.8539600487); nosnoc_py reaches
-// 0.83969 with its own step equilibration, the converged value on finer grids being about
-// 0.8556. x(T) is the target exactly (a hard terminal constraint). Measured: about 13 s of CPU
-// in a Release build, the slowest of these tests.
+// L2_RELAXED_SCALED) give fesd's earlier J = 0.85396 (measured 0.8539600487, 2 switches).
+// nosnoc_py's 0.83969 (4 switches) is another local minimum, the one fesd reaches with
+// heuristic_delta (0.8396952), heuristic_mean or no step equilibration: l2_relaxed ends in the
+// 2-switch solution. x(T) is the target exactly (a hard terminal constraint). Measured: about
+// 10 s of CPU in a Release build, the slowest of these tests.
 TEST(NosnocMotorWithFriction, ObjectiveAndTarget) {
   const fesd::OcpProblem p =
       fesd::load_ocp_problem(std::string(FESD_SOURCE_DIR) + "/examples/motor_with_friction.toml");
