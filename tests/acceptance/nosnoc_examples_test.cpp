@@ -1,11 +1,15 @@
-// nosnoc_py's relay feedback, friction block and periodic stick-slip examples, written as fesd
-// problem files (examples/relay_feedback.toml, friction_block.toml, periodic_stick_slip.toml):
+// nosnoc_py's examples written as fesd problem files. The relay feedback, friction block and
+// periodic stick-slip simulations (examples/relay_feedback.toml, friction_block.toml,
+// periodic_stick_slip.toml):
 // their switch lists at complementarity_tol 1e-6 and 1e-12 (issue 13, item 10: the activity rule
 // theta against lambda and the re-solve with the active set fixed). With the old rule (theta >
 // 1e-6 at some stage) complementarity_tol 1e-6 gave invented switches and failed pinned
 // re-solves on these examples. Each test runs the file's model and settings on a shortened
 // horizon whose switches are known from an event-driven reference solution (matrix exponentials
 // for the relay, RK4 with step 1e-3 and bisection for the others, accurate to 1e-9 or better).
+// Then the motor with friction and cart pole OCPs and the temperature control simulation
+// (examples/motor_with_friction.toml, cart_pole_with_friction.toml, temperature_control.toml)
+// against nosnoc_py's results in NOSNOC-EXAMPLES.md (issue 14).
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -15,6 +19,7 @@
 #include <Eigen/Dense>
 
 #include "fesd/integrator.hpp"
+#include "fesd/ocp.hpp"
 #include "fesd/problem_file.hpp"
 
 namespace {
@@ -188,6 +193,91 @@ TEST(PeriodicStickSlipExit, AnExitAtAStepBoundaryIsLocatedOrMarked) {
   ASSERT_EQ(r.switches.size(), 1u);
   const fesd::SwitchEvent& s = r.switches[0];
   EXPECT_TRUE(!s.located || std::abs(s.t - kCodim2Exit) < 1e-6) << "t = " << s.t;
+}
+
+// ---- Cart pole with friction (OCP) ----------------------------------------------------------
+// nosnoc_py's solve_example() ends at J = 678.50 (NOSNOC-EXAMPLES.md). The file's step
+// equilibration, heuristic_delta (nosnoc_py's default there), reaches the same local minimum
+// (measured 678.5005953, 2 switches as in nosnoc_py; heuristic_mean: 678.4998927); fesd's OCP
+// default l2_relaxed ends in another one (702.27).
+// Measured: about 6 s of CPU in a Release build.
+TEST(NosnocCartPole, ReachesNosnocPysObjective) {
+  const fesd::OcpProblem p = fesd::load_ocp_problem(std::string(FESD_SOURCE_DIR) +
+                                                    "/examples/cart_pole_with_friction.toml");
+  ASSERT_EQ(p.options.discretization.step_eq, fesd::StepEq::HeuristicDelta);
+  ASSERT_TRUE(p.options.constraints_at_stages);
+  const fesd::OcpResult r = fesd::solve(p.ocp, p.options);
+  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+  EXPECT_NEAR(r.objective, 678.50, 5e-3);
+  const Eigen::VectorXd xT = r.x_final();
+  ASSERT_EQ(xT.size(), 4);
+  EXPECT_NEAR(xT[1], M_PI, 1e-3);  // the pole upright (measured 3.1415872)
+  EXPECT_NEAR(xT[0], 0.0, 1e-2);   // the cart back near 0 (measured -3.6e-3)
+  EXPECT_EQ(r.switches.size(), 2u);
+  for (const Eigen::VectorXd& x : r.x) EXPECT_LE(std::abs(x[0]), 5.0 + 1e-8);
+}
+
+// ---- Motor with friction (OCP) -----------------------------------------------------------------
+// The file's settings (30 stages x 2 FE, comp_tol 1e-6, l2_relaxed for nosnoc_py's
+// L2_RELAXED_SCALED) give fesd's earlier J = 0.85396 (measured 0.8539600487, 2 switches).
+// nosnoc_py's 0.83969 (4 switches) is another local minimum, the one fesd reaches with
+// heuristic_delta (0.8396952), heuristic_mean or no step equilibration: l2_relaxed ends in the
+// 2-switch solution. x(T) is the target exactly (a hard terminal constraint). Measured: about
+// 10 s of CPU in a Release build, the slowest of these tests.
+TEST(NosnocMotorWithFriction, ObjectiveAndTarget) {
+  const fesd::OcpProblem p =
+      fesd::load_ocp_problem(std::string(FESD_SOURCE_DIR) + "/examples/motor_with_friction.toml");
+  ASSERT_EQ(p.options.discretization.step_eq, fesd::StepEq::L2Relaxed);
+  const fesd::OcpResult r = fesd::solve(p.ocp, p.options);
+  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+  EXPECT_NEAR(r.objective, 0.85396, 1e-5);
+  const Eigen::VectorXd xT = r.x_final();
+  const double target[] = {0.01, 0.0, 0.01, 0.0, 0.0};
+  ASSERT_EQ(xT.size(), 5);
+  for (Eigen::Index i = 0; i < 5; ++i) EXPECT_NEAR(xT[i], target[i], 1e-8) << i;
+  ASSERT_EQ(r.u.size(), 30u);
+  for (const Eigen::VectorXd& u : r.u) EXPECT_LE(std::abs(u[0]), 5.0 + 1e-8);
+}
+
+// ---- Temperature control with hysteresis (simulation, g-form, time freezing) ------------------
+// The exact temperature as a function of the physical time t (the state named t, which stands
+// still while w jumps): heating y' = -y/5 + 20 from 20 up to 21, then cooling y' = -y/5 down to
+// 17, heating up to 21, and so on.
+double exact_temperature(double t) {
+  double y0 = 20.0;
+  bool heating = true;
+  for (;;) {
+    const double duration =
+        heating ? 5.0 * std::log((100.0 - y0) / (100.0 - 21.0)) : 5.0 * std::log(y0 / 17.0);
+    if (t <= duration)
+      return heating ? 100.0 - (100.0 - y0) * std::exp(-t / 5.0) : y0 * std::exp(-t / 5.0);
+    t -= duration;
+    y0 = heating ? 21.0 : 17.0;
+    heating = !heating;
+  }
+}
+
+// NOSNOC-EXAMPLES.md gives, with the example's loose tolerances (sigma_N = complementarity_tol =
+// 1e-2), a largest error against the exact y(t) of 0.18 for nosnoc_py and 0.36 for fesd: the test
+// asserts 0.36 along the trajectory and at the end. Measured now: 0.078 (at t_phys = 1.12,
+// near the switch-on at 17) and 0.045 at the end, y(3) = 19.4075 (NOSNOC-EXAMPLES.md: 19.58
+// nosnoc_py, 20.60 fesd main 0d0c9fc) at t_phys = 1.7724. The file's own run at N_sim = 30 only
+// (no companion runs); measured about 5 s of CPU in a Release build.
+TEST(NosnocTemperatureControl, FollowsTheHysteresisInPhysicalTime) {
+  SimulationProblem p = fesd::load_simulation_problem(std::string(FESD_SOURCE_DIR) +
+                                                      "/examples/temperature_control.toml");
+  const IntegratorResult r = run_example(p);
+  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+  double worst = 0;
+  for (const Eigen::VectorXd& x : r.x)
+    worst = std::max(worst, std::abs(x[0] - exact_temperature(x[2])));
+  EXPECT_LE(worst, 0.36);
+  const Eigen::VectorXd xT = r.x_final();
+  EXPECT_LE(std::abs(xT[0] - exact_temperature(xT[2])), 0.36) << "y(3) = " << xT[0];
+  // Two jumps of w (0 -> 1 at 21, 1 -> 0 at 17) and the third (0 -> 1) done by t = 3: w(3) = 1,
+  // and about 3 - 3 * 0.4 of physical time has passed (exact 1.80).
+  EXPECT_NEAR(xT[1], 1.0, 1e-2);
+  EXPECT_NEAR(xT[2], 1.8, 0.1);
 }
 
 }  // namespace
