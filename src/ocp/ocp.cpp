@@ -426,6 +426,26 @@ double cost(const OcpNlp& b, const Ocp& ocp, const std::vector<double>& w,
   return r.objective;
 }
 
+/// Solves the last NLP once more from `start` with `bounds` (active sets fixed). The result is
+/// kept if it converges and keep(its cost) holds; else the point before is restored.
+template <class Account, class Keep>
+bool try_resolve(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Eigen::VectorXd& p,
+                 nlp::NlpSolver& solver, const Account& account, mpcc::HomotopyResult& hr,
+                 const std::vector<double>& start, const std::vector<nlp::Bound>& bounds,
+                 int n_pins, const Keep& keep) {
+  mpcc::Problem& mp = b.mpcc;
+  const nlp::Iterate before = mp.iterate();
+  const mpcc::HomotopyResult again = mp.solve_again(solver, o.homotopy, bounds, n_pins, &start);
+  if (o.on_homotopy_row) o.on_homotopy_row(again.rows.back());
+  account(again);
+  if (again.status == Status::Success && keep(cost(b, ocp, mp.solution(), p))) {
+    hr.comp_residual = again.comp_residual;
+    return true;
+  }
+  mp.restore(before);
+  return false;
+}
+
 /// Switches held by the grid (docs/formulation.md, "Switches held by the grid"): while the
 /// solution has a switch on an element boundary whose neighbouring elements sit at an h bound,
 /// re-place the boundaries of those intervals (FesdInterval::regrid) and solve the last NLP from
@@ -461,19 +481,11 @@ void move_held_switches(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Ei
       for (const nlp::Bound& bd : iv->pin_bounds(moved.data(), pins)) bounds.push_back(bd);
     }
     const double cost_before = cost(b, ocp, w, p);
-    const nlp::Iterate before = mp.iterate();
-    const mpcc::HomotopyResult again = mp.solve_again(solver, o.homotopy, bounds, n_pins, &moved);
-    if (o.on_homotopy_row) o.on_homotopy_row(again.rows.back());
-    account(again);
-    const bool kept =
-        again.status == Status::Success &&
-        cost(b, ocp, mp.solution(), p) <= cost_before + 1e-9 * std::max(1.0, std::abs(cost_before));
-    if (!kept) {
-      mp.restore(before);
+    const double slack = 1e-9 * std::max(1.0, std::abs(cost_before));
+    if (!try_resolve(b, ocp, o, p, solver, account, hr, moved, bounds, n_pins,
+                     [&](double c) { return c <= cost_before + slack; }))
       break;
-    }
     ++summary.grid_moves;
-    hr.comp_residual = again.comp_residual;
   }
 }
 
@@ -507,19 +519,13 @@ void probe_touches(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Eigen::
           for (const nlp::Bound& bd :
                j == k ? b.iv[j]->active_set_bounds(active) : b.iv[j]->pin_bounds(start.data(), {}))
             bounds.push_back(bd);
-        const nlp::Iterate before = mp.iterate();
-        const mpcc::HomotopyResult again = mp.solve_again(solver, o.homotopy, bounds, 0, &start);
-        if (o.on_homotopy_row) o.on_homotopy_row(again.rows.back());
-        account(again);
-        if (again.status == Status::Success &&
-            cost(b, ocp, mp.solution(), p) <
-                cost_before - 1e-9 * std::max(1.0, std::abs(cost_before))) {
+        const double slack = 1e-9 * std::max(1.0, std::abs(cost_before));
+        if (try_resolve(b, ocp, o, p, solver, account, hr, start, bounds, 0,
+                        [&](double c) { return c < cost_before - slack; })) {
           ++summary.born_switches;
-          hr.comp_residual = again.comp_residual;
           improved = true;
           break;
         }
-        mp.restore(before);
       }
     }
     if (improved) move_held_switches(b, ocp, o, p, solver, account, hr, summary);
