@@ -135,9 +135,7 @@ int main(int argc, char** argv) {
       fesd_bench::usage("unknown argument " + a);
     }
   }
-  std::vector<double> guesses;
-  for (int k = 0; k < n_guesses; ++k)
-    guesses.push_back(n_guesses == 1 ? 0.5 : -3.0 + 6.0 * k / (n_guesses - 1));
+  const std::vector<double> guesses = fesd_bench::sensitivity_guesses(n_guesses);
   std::vector<Config> configs = table == "schemes" ? scheme_configs() : method_configs();
   if (!only.empty())
     std::erase_if(configs, [&](const Config& c) { return c.name.find(only) == std::string::npos; });

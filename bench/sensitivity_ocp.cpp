@@ -82,9 +82,7 @@ int main(int argc, char** argv) {
       fesd_bench::usage("unknown argument " + a);
     }
   }
-  std::vector<double> guesses;
-  for (int k = 0; k < n_guesses; ++k)
-    guesses.push_back(n_guesses == 1 ? 0.5 : -3.0 + 6.0 * k / (n_guesses - 1));
+  const std::vector<double> guesses = fesd_bench::sensitivity_guesses(n_guesses);
 
   const double x_star = fesd_bench::kSensitivityX0Star;
   std::vector<std::vector<Run>> runs(std::size(kCombos));

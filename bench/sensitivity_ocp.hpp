@@ -6,6 +6,7 @@
 // local minimizer is x0* = (9 - sqrt(417)) / 8 with V* = 1.5237727753749571.
 #pragma once
 #include <cmath>
+#include <vector>
 
 #include <Eigen/Dense>
 
@@ -16,6 +17,14 @@ namespace fesd_bench {
 
 inline const double kSensitivityX0Star = (9.0 - std::sqrt(417.0)) / 8.0;
 inline constexpr double kSensitivityVStar = 1.5237727753749571;
+
+/// The initial guesses of Fig. 9 (right): n values of x0 spread evenly over [-3, 3] (0.5 for n =
+/// 1).
+inline std::vector<double> sensitivity_guesses(int n) {
+  std::vector<double> g;
+  for (int k = 0; k < n; ++k) g.push_back(n == 1 ? 0.5 : -3.0 + 6.0 * k / (n - 1));
+  return g;
+}
 
 /// x' in 2 - sign(x): region 0 (c = x > 0): x' = 1, region 1 (x < 0): x' = 3.
 struct SensitivityModel {

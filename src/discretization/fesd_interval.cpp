@@ -172,11 +172,6 @@ struct StepEquilibrationEq {
   }
 };
 
-/// Whether region r is in a (sorted or not) list of regions.
-bool has(const std::vector<int>& regions, int r) {
-  return std::find(regions.begin(), regions.end(), r) != regions.end();
-}
-
 }  // namespace
 
 FesdInterval::FesdInterval(const Pss& model, const Tableau& tableau,
@@ -554,6 +549,12 @@ std::vector<int> FesdInterval::active_set(const double* w, int n) const {
   return active;
 }
 
+std::vector<std::vector<int>> FesdInterval::active_sets(const double* w) const {
+  std::vector<std::vector<int>> active(N_FE_);
+  for (int n = 0; n < N_FE_; ++n) active[n] = active_set(w, n);
+  return active;
+}
+
 std::vector<int> FesdInterval::exit_regions(const Pss& model, const std::vector<int>& before,
                                             const std::vector<int>& after) {
   std::vector<int> exits;
@@ -571,11 +572,10 @@ std::vector<int> FesdInterval::exit_regions(const Pss& model, const std::vector<
 std::vector<FesdInterval::ExitPin> FesdInterval::exits_to_pin(const double* w,
                                                               bool control_jump_at_end) const {
   std::vector<ExitPin> pins;
-  std::vector<std::vector<int>> active(N_FE_);
-  for (int n = 0; n < N_FE_; ++n) active[n] = active_set(w, n);
+  std::vector<std::vector<int>> active = active_sets(w);
   for (int n = 0; n + 1 < N_FE_; ++n)
     // (an element of length ~0 with both regions active is a crossing, not a sliding mode)
-    if (w[h(n)] > kHeldTol * in_.T / N_FE_)
+    if (!collapsed(w, n))
       for (int r : exit_regions(model_, active[n], active[n + 1])) pins.push_back({n, r, true});
   // An exit inside the last element: r slides there and has left the surface by its end.
   const int last = N_FE_ - 1;
@@ -605,8 +605,7 @@ std::vector<nlp::Bound> FesdInterval::pin_bounds(const double* w,
         "FesdInterval::pin_bounds needs FESD (and a stiffly accurate scheme to pin exits)");
   // The active sets to fix: the solution's, with each pinned exit's region kept in its element
   // and (theta_zero) removed from the next.
-  std::vector<std::vector<int>> active(N_FE_);
-  for (int n = 0; n < N_FE_; ++n) active[n] = active_set(w, n);
+  std::vector<std::vector<int>> active = active_sets(w);
   for (const ExitPin& pin : pins) {
     if (!has(active[pin.n], pin.r)) {
       active[pin.n].push_back(pin.r);

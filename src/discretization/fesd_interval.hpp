@@ -14,6 +14,7 @@
 // Integrator and OCP both build their NLPs from this block; its layout (which variable is
 // theta_{n,m,r}, h_n, ...) stays reachable for active-set and sensitivity code.
 #pragma once
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -56,6 +57,11 @@ struct IntervalInputs {
   /// (OCP with free x0), and more robust than fixed values when s0 lies on a switching surface.
   bool lp_at_start = false;
 };
+
+/// Whether region r is in a (sorted or not) list of regions.
+inline bool has(const std::vector<int>& regions, int r) {
+  return std::find(regions.begin(), regions.end(), r) != regions.end();
+}
 
 class FesdInterval {
  public:
@@ -116,6 +122,8 @@ class FesdInterval {
   /// Region r at stage m of element n: theta_{n,m,r} > max(|lambda_{n,m,r}|, kActiveThetaTol),
   /// the stage-wise form of active_set().
   bool stage_active(const double* w, int n, int m, int r) const;
+  /// active_set() of every element.
+  std::vector<std::vector<int>> active_sets(const double* w) const;
   static constexpr double kActiveThetaTol = 1e-6;
 
   // ---- sliding exits (docs/formulation.md, "Leaving a sliding mode") ----
@@ -219,6 +227,9 @@ class FesdInterval {
 
  private:
   int idx(int n, int m) const { return n * n_s_ + m; }
+  /// Tolerance of "h_n at a bound" and of a collapsed element (h_n ~ 0): kHeldTol h0.
+  double held_tol() const { return kHeldTol * in_.T / N_FE_; }
+  bool collapsed(const double* w, int n) const { return w[h(n)] <= held_tol(); }
   void build_complementarity();
 
   const Pss& model_;

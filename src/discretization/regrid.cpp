@@ -21,7 +21,7 @@ std::vector<int> FesdInterval::segment_boundaries(const double* w) const {
   // Segments of length ~0 (elements collapsed at a switch, e.g. a crossing written as
   // {1} -> {0,1} -> {0} through an element of length 0) join the segment after them (the last
   // one the segment before): the switch is one event at one time.
-  const double tol = kHeldTol * in_.T / N_FE_;
+  const double tol = held_tol();
   auto length = [&](int first, int end) {
     double s = 0;
     for (int n = first; n < end; ++n) s += w[h(n)];
@@ -40,7 +40,7 @@ std::vector<int> FesdInterval::segment_boundaries(const double* w) const {
 std::vector<int> FesdInterval::held_switches(const double* w) const {
   std::vector<int> held;
   if (!opt_.use_fesd) return held;
-  const double h0 = in_.T / N_FE_, tol = kHeldTol * h0;
+  const double h0 = in_.T / N_FE_, tol = held_tol();
   const double lb = (1.0 - opt_.gamma_h) * h0, ub = (1.0 + opt_.gamma_h) * h0;
   // Every element of [first, end) at a bound: all at the same one (the segment cannot grow, or
   // cannot shrink), or a mix, such as a collapsed element next to one at the upper bound, which
@@ -103,7 +103,7 @@ bool FesdInterval::regrid(const double* w_old, std::vector<double>& w_new) const
   const std::vector<int> count = apportion(lengths, N_FE_);
   for (std::size_t j = 0; j < J; ++j) {
     const double hj = lengths[j] / count[j];
-    if (hj < lb - kHeldTol * h0 || hj > ub + kHeldTol * h0) return false;
+    if (hj < lb - held_tol() || hj > ub + held_tol()) return false;
   }
 
   // Interpolation nodes of an old element: its start, the stage points strictly inside, its end.
@@ -169,15 +169,10 @@ bool FesdInterval::regrid(const double* w_old, std::vector<double>& w_new) const
 std::vector<FesdInterval::Touch> FesdInterval::touches(const double* w) const {
   std::vector<Touch> out;
   if (!opt_.use_fesd) return out;
-  std::vector<std::vector<int>> active(N_FE_);
-  for (int n = 0; n < N_FE_; ++n) active[n] = active_set(w, n);
-  auto contains = [](const std::vector<int>& a, int r) {
-    return std::find(a.begin(), a.end(), r) != a.end();
-  };
-  const double tol = kHeldTol * in_.T / N_FE_;
+  std::vector<std::vector<int>> active = active_sets(w);
   int prev = -1;  // the last element before n of positive length
   for (int n = 0; n < N_FE_; ++n) {
-    if (w[h(n)] <= tol) continue;  // collapsed: its start point is that of the next element
+    if (collapsed(w, n)) continue;  // collapsed: its start point is that of the next element
     const bool switch_here = prev >= 0 && active[n] != active[prev];
     prev = n;
     if (switch_here) continue;                           // a switch, not a touch
@@ -186,7 +181,7 @@ std::vector<FesdInterval::Touch> FesdInterval::touches(const double* w) const {
       const int first = model_.region_offset(k), end = model_.region_offset(k + 1);
       int n_active = 0, only = -1;
       for (int j = first; j < end; ++j)
-        if (contains(active[n], j)) ++n_active, only = j;
+        if (has(active[n], j)) ++n_active, only = j;
       if (n_active != 1) continue;
       for (int r = first; r < end; ++r)
         if (r != only && std::abs(w[point[r]]) <= kTouchTol) out.push_back({n, r, only});
@@ -197,8 +192,7 @@ std::vector<FesdInterval::Touch> FesdInterval::touches(const double* w) const {
 
 std::vector<std::vector<int>> FesdInterval::probe(const double* w, const Touch& t,
                                                   std::vector<double>& w_new) const {
-  std::vector<std::vector<int>> active(N_FE_);
-  for (int n = 0; n < N_FE_; ++n) active[n] = active_set(w, n);
+  std::vector<std::vector<int>> active = active_sets(w);
   std::vector<int>& a = active[t.n];
   std::erase(a, t.instead);
   a.push_back(t.r);
@@ -210,8 +204,7 @@ std::vector<std::vector<int>> FesdInterval::probe(const double* w, const Touch& 
   // Collapsed elements right before the touch (length ~0, e.g. both regions active at a free x0
   // on the surface) are part of it: they take the new set too, or they would hold the state on
   // the surface.
-  const double tol = kHeldTol * in_.T / N_FE_;
-  for (int n = t.n - 1; n >= 0 && w[h(n)] <= tol; --n) {
+  for (int n = t.n - 1; n >= 0 && collapsed(w, n); --n) {
     active[n] = a;
     for (int s = 0; s < n_s_; ++s)
       for (int r = 0; r < model_.n_theta(); ++r) w_new[theta(n, s, r)] = w_new[theta(t.n, s, r)];

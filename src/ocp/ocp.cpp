@@ -426,6 +426,25 @@ double cost(const OcpNlp& b, const Ocp& ocp, const std::vector<double>& w,
   return r.objective;
 }
 
+/// The bounds that fix the active set of every element (FesdInterval::pin_bounds) at w, with the
+/// sliding exits of each interval pinned when `pin` (and its scheme can pin). Intervals without
+/// an exit to pin are fixed only if `every_interval`; interval `skip` not at all (the caller
+/// gives its bounds). Returns the number of pinned exits.
+int fix_active_sets(const OcpNlp& b, const std::vector<double>& w, bool pin, bool every_interval,
+                    std::vector<nlp::Bound>& bounds,
+                    std::size_t skip = std::numeric_limits<std::size_t>::max()) {
+  int n_pins = 0;
+  for (std::size_t k = 0; k < b.iv.size(); ++k) {
+    const FesdInterval& iv = *b.iv[k];
+    std::vector<FesdInterval::ExitPin> pins;
+    if (pin && iv.can_pin_exits()) pins = iv.exits_to_pin(w.data(), /*control_jump_at_end=*/true);
+    if (k == skip || (pins.empty() && !every_interval)) continue;
+    n_pins += static_cast<int>(pins.size());
+    for (const nlp::Bound& bd : iv.pin_bounds(w.data(), pins)) bounds.push_back(bd);
+  }
+  return n_pins;
+}
+
 /// Solves the last NLP once more from `start` with `bounds` (active sets fixed). The result is
 /// kept if it converges and keep(its cost) holds; else the point before is restored.
 template <class Account, class Keep>
@@ -458,28 +477,16 @@ void move_held_switches(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Ei
                         nlp::NlpSolver& solver, const Account& account, mpcc::HomotopyResult& hr,
                         Summary& summary) {
   constexpr int kMaxGridMoves = 8;
-  mpcc::Problem& mp = b.mpcc;
-  auto held_count = [&](const std::vector<double>& w) {
-    int n = 0;
-    for (const auto& iv : b.iv) n += static_cast<int>(iv->held_switches(w.data()).size());
-    return n;
-  };
-  for (int round = 0; round < kMaxGridMoves && held_count(mp.solution()) > 0; ++round) {
-    const std::vector<double> w = mp.solution();
+  for (int round = 0; round < kMaxGridMoves; ++round) {
+    const std::vector<double> w = b.mpcc.solution();
     std::vector<double> moved = w;
-    bool any = false;
+    bool any = false;  // some interval had a held switch and could be re-gridded
     for (const auto& iv : b.iv)
       if (!iv->held_switches(w.data()).empty()) any = iv->regrid(w.data(), moved) || any;
     if (!any) break;
     std::vector<nlp::Bound> bounds;
-    int n_pins = 0;
-    for (const auto& iv : b.iv) {
-      std::vector<FesdInterval::ExitPin> pins;
-      if (o.discretization.pin_sliding_exits && iv->can_pin_exits())
-        pins = iv->exits_to_pin(moved.data(), /*control_jump_at_end=*/true);
-      n_pins += static_cast<int>(pins.size());
-      for (const nlp::Bound& bd : iv->pin_bounds(moved.data(), pins)) bounds.push_back(bd);
-    }
+    const int n_pins = fix_active_sets(b, moved, o.discretization.pin_sliding_exits,
+                                       /*every_interval=*/true, bounds);
     const double cost_before = cost(b, ocp, w, p);
     const double slack = 1e-9 * std::max(1.0, std::abs(cost_before));
     if (!try_resolve(b, ocp, o, p, solver, account, hr, moved, bounds, n_pins,
@@ -514,11 +521,8 @@ void probe_touches(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Eigen::
         ++probes;
         std::vector<double> start = w;
         const auto active = b.iv[k]->probe(w.data(), t, start);
-        std::vector<nlp::Bound> bounds;
-        for (std::size_t j = 0; j < b.iv.size(); ++j)
-          for (const nlp::Bound& bd :
-               j == k ? b.iv[j]->active_set_bounds(active) : b.iv[j]->pin_bounds(start.data(), {}))
-            bounds.push_back(bd);
+        std::vector<nlp::Bound> bounds = b.iv[k]->active_set_bounds(active);
+        fix_active_sets(b, start, /*pin=*/false, /*every_interval=*/true, bounds, /*skip=*/k);
         const double slack = 1e-9 * std::max(1.0, std::abs(cost_before));
         if (try_resolve(b, ocp, o, p, solver, account, hr, start, bounds, 0,
                         [&](double c) { return c < cost_before - slack; })) {
@@ -634,14 +638,8 @@ OcpResult solve(const Ocp& ocp, const OcpOptions& options) {
     // vector field, so a mode may end there with theta > 0; one that ends inside the last
     // element of an interval is kept on the surface up to the boundary instead.
     std::vector<nlp::Bound> bounds;
-    int n_pins = 0;
-    const double* w = mp.solution().data();
-    for (const auto& iv : b->iv) {
-      const auto pins = iv->exits_to_pin(w, /*control_jump_at_end=*/true);
-      if (pins.empty()) continue;
-      n_pins += static_cast<int>(pins.size());
-      for (const nlp::Bound& bd : iv->pin_bounds(w, pins)) bounds.push_back(bd);
-    }
+    const int n_pins =
+        fix_active_sets(*b, mp.solution(), /*pin=*/true, /*every_interval=*/false, bounds);
     if (n_pins > 0) {
       const mpcc::HomotopyResult again = mp.solve_again(*solver, options.homotopy, bounds, n_pins);
       if (options.on_homotopy_row) options.on_homotopy_row(again.rows.back());
