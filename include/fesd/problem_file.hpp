@@ -27,6 +27,7 @@ struct SimulationProblem {
   int N_sim = 0;            ///< [simulation] N_sim >= 0; 0: chosen by tol_sim (simulate())
   double tol_sim = 0;       ///< [simulation] tol_sim >= 0 (AccuracyOptions::tol_sim)
   int N_sim_max = 1000;     ///< [simulation] N_sim_max >= 1 (AccuracyOptions::N_sim_max)
+  bool error_estimate = true;  ///< [simulation] error_estimate (AccuracyOptions::error_estimate)
   IntegratorOptions options;
   /// True if an expression uses the time `t`: then a clock state named "t" with t' = 1 is
   /// appended to x (nosnoc does the same), and its initial value is [simulation] t0 (default 0).

@@ -423,6 +423,7 @@ void print_header(const fesd::SimulationProblem& problem) {
   accuracy.tol_sim = problem.tol_sim;
   accuracy.N_sim = problem.N_sim;
   accuracy.N_sim_max = problem.N_sim_max;
+  accuracy.error_estimate = problem.error_estimate;
   out::print("  simulation  T_sim = {:g}, {}; fix_active_set = {}\n", problem.T_sim,
              fesd::format_accuracy_rule(accuracy, problem.T_sim),
              yes_no(o.homotopy.fix_active_set));

@@ -145,6 +145,14 @@ std::string N_sim_at_most_N_sim_max(const T& t, double N_sim) {
       *t.N_sim_max);
 }
 
+/// Without the estimate there is nothing to choose N_sim by: it must be given, without tol_sim.
+std::string no_estimate_needs_N_sim(const T& t, double error_estimate) {
+  if (error_estimate != 0 || t.N_sim == nullptr || t.tol_sim == nullptr ||
+      (*t.N_sim > 0 && !(*t.tol_sim > 0)))
+    return {};
+  return "needs N_sim and no tol_sim (N_sim is otherwise chosen from error estimates)";
+}
+
 std::string ell_1_needs_terminal_constraints(const T& t, double mode) {
   if (static_cast<TerminalConstraint>(static_cast<int>(mode)) != TerminalConstraint::L1 ||
       t.ocp->n_g_terminal > 0)
@@ -182,6 +190,10 @@ std::vector<Option> build() {
       at_least(0, "(0: 1e-6 if N_sim is not given, else no target)")));
   o.push_back(scalar<&T::N_sim_max>(kSim, "N_sim_max", Use::Simulation,
                                     "the largest N_sim tried to reach tol_sim", "", at_least(1)));
+  with(scalar<&T::error_estimate>(
+           kSim, "error_estimate", Use::Simulation,
+           "with N_sim given, estimate the error from two companion runs (false: one run)", ""),
+       [](Option& x) { x.rule = no_estimate_needs_N_sim; });
   o.push_back(input(kSim, "u", Use::Simulation,
                     "constant control values, one per control (comma-separated)", "", true));
   o.push_back(input(kSim, "t0", Use::Simulation,
@@ -545,10 +557,13 @@ std::vector<std::string> validate_simulation(double T_sim, int N_sim, double t0)
 }
 
 std::vector<std::string> validate_simulation(double T_sim, int N_sim, double tol_sim, int N_sim_max,
-                                             double t0) {
-  std::vector<std::string> e = check(
-      Table::Simulation,
-      OptionTarget{.T_sim = &T_sim, .N_sim = &N_sim, .tol_sim = &tol_sim, .N_sim_max = &N_sim_max});
+                                             double t0, bool error_estimate) {
+  std::vector<std::string> e =
+      check(Table::Simulation, OptionTarget{.T_sim = &T_sim,
+                                            .N_sim = &N_sim,
+                                            .tol_sim = &tol_sim,
+                                            .N_sim_max = &N_sim_max,
+                                            .error_estimate = &error_estimate});
   // The smallest step, docs/problem-files.md "Limits": of N_sim if given, else of one step (a
   // search for tol_sim stops where the step would become shorter).
   if (e.empty())

@@ -46,6 +46,7 @@ struct OptionTarget {
   int* N_sim = nullptr;
   double* tol_sim = nullptr;  ///< simulate()'s accuracy target (AccuracyOptions)
   int* N_sim_max = nullptr;
+  bool* error_estimate = nullptr;  ///< simulate()'s companion runs (AccuracyOptions)
   Ocp* ocp = nullptr;                 ///< [ocp] keys stored in the problem
   OcpOptions* ocp_options = nullptr;  ///< [ocp] keys stored in the solver options
 };
@@ -152,7 +153,7 @@ std::vector<std::string> validate_simulation(double T_sim, int N_sim, double t0 
 /// The same for simulate() and simulation problem files, with its accuracy keys: N_sim = 0
 /// (chosen by tol_sim) allowed, tol_sim, N_sim_max.
 std::vector<std::string> validate_simulation(double T_sim, int N_sim, double tol_sim, int N_sim_max,
-                                             double t0);
+                                             double t0, bool error_estimate = true);
 
 /// Messages joined by "; ".
 std::string join(const std::vector<std::string>& messages);

@@ -229,6 +229,8 @@ class Simulation {
     Run r = run(N);
     report();
     if (!r.ok()) return finish(std::move(r), 0, "no estimate: the run failed");
+    if (!acc_.error_estimate)
+      return finish(std::move(r), 0, "no estimate: error_estimate = false (one run at N_sim)");
     const auto [n_c, n_d] = companions(N);
     const Run c = run(n_c);
     report();
@@ -386,8 +388,9 @@ class Simulation {
 IntegratorResult simulate(const Pss& model, const Eigen::VectorXd& x0, double T_sim,
                           const AccuracyOptions& accuracy, const IntegratorOptions& options,
                           const Eigen::VectorXd& u, const Eigen::VectorXd& p) {
-  if (const auto e = registry::validate_simulation(T_sim, accuracy.N_sim, accuracy.tol_sim,
-                                                   accuracy.N_sim_max, 0.0);
+  if (const auto e =
+          registry::validate_simulation(T_sim, accuracy.N_sim, accuracy.tol_sim, accuracy.N_sim_max,
+                                        0.0, accuracy.error_estimate);
       !e.empty())
     throw InvalidOption(registry::join(e));
   Simulation s(model, x0, T_sim, accuracy, options, u, p);
@@ -401,11 +404,15 @@ IntegratorResult simulate(const SimulationProblem& q,
   a.tol_sim = q.tol_sim;
   a.N_sim = q.N_sim;
   a.N_sim_max = q.N_sim_max;
+  a.error_estimate = q.error_estimate;
   a.on_run = on_run;
   return simulate(q.model, q.x0, q.T_sim, a, q.options, q.u, q.p);
 }
 
 std::string format_accuracy_rule(const AccuracyOptions& a, double T_sim) {
+  if (a.N_sim > 0 && a.tol_sim == 0 && !a.error_estimate)
+    return fmt::format("N_sim = {} (step {:g}); no error estimate (error_estimate = false)",
+                       a.N_sim, T_sim / a.N_sim);
   if (a.N_sim > 0 && a.tol_sim == 0) {
     const auto [c, d] = companions(a.N_sim);
     return fmt::format(

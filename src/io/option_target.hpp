@@ -12,6 +12,7 @@ inline registry::OptionTarget target_of(SimulationProblem& q) {
   t.N_sim = &q.N_sim;
   t.tol_sim = &q.tol_sim;
   t.N_sim_max = &q.N_sim_max;
+  t.error_estimate = &q.error_estimate;
   return t;
 }
 

@@ -38,7 +38,7 @@ constexpr registry::Use kKind = registry::Use::Simulation;
 std::vector<std::string> validate_all(const SimulationProblem& q) {
   const double t0 = q.has_clock ? q.x0[q.x0.size() - 1] : 0.0;  // the clock starts at t0
   std::vector<std::string> e =
-      registry::validate_simulation(q.T_sim, q.N_sim, q.tol_sim, q.N_sim_max, t0);
+      registry::validate_simulation(q.T_sim, q.N_sim, q.tol_sim, q.N_sim_max, t0, q.error_estimate);
   std::vector<std::string> options = validate(q.options);
   if (options.empty())  // the limits of build(), docs/problem-files.md "Limits"
     options = discretization::FesdInterval::block_size_errors(q.model, q.options.discretization);

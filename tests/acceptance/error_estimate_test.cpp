@@ -242,6 +242,36 @@ TEST(ErrorEstimate, GivenNSimOnTheOscillatorCarriesAnEstimate) {
   EXPECT_EQ(j.at("accuracy").at("runs").at(1).at("N_sim").get<int>(), 8);
 }
 
+// error_estimate = false: only the run at N_sim, the same result as with the companions, no
+// estimate; without N_sim (or with tol_sim) there is nothing to choose N_sim by: rejected.
+TEST(ErrorEstimate, NoEstimateRunsOnlyNSim) {
+  fesd::SimulationProblem q = fesd::load_simulation_problem(kOscillator);
+  fesd::apply_override(q, "N_sim", "16");
+  const fesd::IntegratorResult with = fesd::simulate(q);
+  fesd::apply_override(q, "error_estimate", "false");
+  const fesd::IntegratorResult r = fesd::simulate(q);
+  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+  EXPECT_EQ(run_sizes(r.accuracy), (std::vector<int>{16}));
+  EXPECT_TRUE(std::isnan(r.accuracy.error_estimate));
+  EXPECT_NE(r.accuracy.note.find("error_estimate = false"), std::string::npos) << r.accuracy.note;
+  EXPECT_EQ(r.x_final(), with.x_final());  // the same run, bit for bit
+  EXPECT_EQ(r.h.size(), with.h.size());
+
+  try {
+    fesd::apply_override(q, "N_sim", "0");
+    ADD_FAILURE() << "error_estimate = false without N_sim accepted";
+  } catch (const fesd::InvalidOption& e) {
+    EXPECT_NE(std::string(e.what()).find("simulation.error_estimate = false: needs N_sim"),
+              std::string::npos)
+        << e.what();
+  }
+  fesd::AccuracyOptions acc;  // the library call checks the same rule
+  acc.N_sim = 16;
+  acc.tol_sim = 1e-6;
+  acc.error_estimate = false;
+  EXPECT_THROW(fesd::simulate(q.model, q.x0, q.T_sim, acc, q.options), fesd::InvalidOption);
+}
+
 // A model every Runge-Kutta scheme integrates exactly (x' = 2 - sign(x), piecewise linear): the
 // runs agree to round-off, so the estimate is the NLP noise floor 10 ipopt.tol max(1, |x(T)|),
 // and says so.
