@@ -257,6 +257,7 @@ class Integrator {
     res_.summary.max_comp_residual = std::max(res_.summary.max_comp_residual, hr.comp_residual);
     const std::size_t first_switch = res_.switches.size();
     const double t_step = t_;
+    report_held_switches(*solved, t_step);
     accept(*solved);
     // An exit at the end of the step before, whose pin failed there, is recorded here (the switch
     // at a step boundary belongs to the step that starts at it).
@@ -360,6 +361,23 @@ class Integrator {
     std::vector<int> regions;
     for (const auto& pin : pins) regions.push_back(pin.r);
     return regions;
+  }
+
+  /// Switches of the accepted step held by the grid (FesdInterval::held_switches, as in the OCP):
+  /// a neighbouring segment has every element length at a bound (1 +- gamma_h) h, so the switch
+  /// may have been stopped short of its time. Counted and named in a warning, never silent.
+  void report_held_switches(const StepProblem& sp, double t_step) {
+    const std::vector<double>& w = sp.mpcc.solution();
+    for (int n : sp.iv->held_switches(w.data())) {
+      double t = t_step;
+      for (int e = 0; e < n; ++e) t += w[sp.iv->h(e)];
+      ++res_.summary.held_switches;
+      res_.summary.warnings.push_back(fmt::format(
+          "the switch at t = {:.6g} is held by the grid: the element lengths next to it are at "
+          "their bounds (1 +- gamma_h) h, so its time may be wrong (use a larger gamma_h, or "
+          "another N_sim or N_FE)",
+          t));
+    }
   }
 
   /// Marks the exits among the switches from index `first` on (those of the step that started at
@@ -494,6 +512,14 @@ class Integrator {
     res_.message = fmt::format(
         "step {} of {} (t = {:.6g}): {} (last IPOPT status {}, complementarity residual {:.2e})",
         step + 1, N_sim_, t_, describe(last_.status), last_.last_nlp_status, last_.comp_residual);
+    // The usual cause when a switch cannot be reached: its last attempt ends with the switch on a
+    // boundary whose element lengths are at their bounds.
+    if (failed_ != nullptr && !failed_->iv->held_switches(failed_->mpcc.solution().data()).empty())
+      res_.message += fmt::format(
+          "; its last attempt has a switch held by the grid (element lengths at their bounds "
+          "(1 +- gamma_h) h, gamma_h = {:g}): a larger gamma_h or another N_sim lets the "
+          "element boundaries reach it",
+          d_.gamma_h);
   }
 
   Eigen::VectorXd xdot_at(const Eigen::VectorXd& x, const Eigen::VectorXd& theta) const {

@@ -133,6 +133,29 @@ TEST_P(LeavingSlidingSweep, ExitAtOne) {
 
 INSTANTIATE_TEST_SUITE_P(NSim, LeavingSlidingSweep, ::testing::Values(40, 47));
 
+// A switch the element boundaries cannot reach (issue 14, item 1: the held-switch check runs in
+// the integrator too). Example 3(a), x' = 2 - sign(x) from x0 = -1 (crossing at t = 1/3), one step
+// over [0, 1] with N_FE = 2 and gamma_h = 0.1: every boundary lies in [0.45, 0.55] (and for the
+// refined and split retries of the step equally out of reach), so the run must fail and say why,
+// not return a switch at a bound; with N_sim = 3 the first step's boundary reaches 1/3 exactly.
+TEST(HeldSwitch, UnreachableSwitchFailsAndSaysWhy) {
+  const fesd::SimulationProblem q =
+      fesd::load_simulation_problem(FESD_SOURCE_DIR "/examples/crossing.toml");
+  IntegratorOptions o = q.options;
+  o.discretization.gamma_h = 0.1;
+  const auto r = fesd::integrate(q.model, q.x0, 1.0, 1, o);
+  EXPECT_NE(r.status, fesd::Status::Success);
+  EXPECT_NE(r.message.find("switch held by the grid"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("gamma_h = 0.1"), std::string::npos) << r.message;
+
+  const auto ok = fesd::integrate(q.model, q.x0, 1.0, 3, o);
+  ASSERT_EQ(ok.status, fesd::Status::Success) << ok.message;
+  ASSERT_EQ(ok.switches.size(), 1u);
+  EXPECT_NEAR(ok.switches[0].t, 1.0 / 3.0, 1e-9);
+  EXPECT_EQ(ok.summary.held_switches, 0);
+  EXPECT_NEAR(ok.x_final()[0], 1.0 - 1.0 / 3.0, 1e-9);  // x = -1 + 3 t, then x = t - 1/3
+}
+
 // One switch per event at control-grid points. x' = 2 + u for x < 0, 1.5 + u for x > 0 from
 // x0 = -1, min int u^2, |u| <= 0.1: u = 0 and the crossing is at t = 0.5, exactly the boundary of
 // the two control intervals.
