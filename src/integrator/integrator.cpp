@@ -478,7 +478,7 @@ class Integrator {
 
   mpcc::HomotopyResult homotopy(StepProblem& sp, const HomotopyOptions& hopt,
                                 std::vector<HomotopyRow>& rows) {
-    mpcc::HomotopyResult hr = sp.mpcc.solve_homotopy(*solver_, hopt);
+    mpcc::HomotopyResult hr = sp.mpcc.solve_homotopy(*solver_, hopt, {}, mpcc::kStepWarmMaxIter);
     account(hr, rows);
     return hr;
   }

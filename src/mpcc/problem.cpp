@@ -122,7 +122,7 @@ void Problem::copy_inputs_from(const Problem& other) {
 // ---- solving ----------------------------------------------------------------------------------
 
 HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOptions& o,
-                                       const HomotopyCallback& on_row) {
+                                       const HomotopyCallback& on_row, int warm_max_iter) {
   if (!finalized()) throw InternalError("mpcc::Problem::solve_homotopy(): not finalized");
   HomotopyResult res;
   it_ = nlp::Iterate{};
@@ -140,7 +140,8 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
     const bool loose = !tight_now && o.intermediate_tol > 0 &&
                        sigma > kTightSigmaFactor * o.complementarity_tol && sigma > o.sigma_N;
     const nlp::NlpResult r =
-        solver.solve(nlp_, it_, /*warm_start=*/k > 0, loose ? o.intermediate_tol : 0.0, 0);
+        solver.solve(nlp_, it_, /*warm_start=*/k > 0, loose ? o.intermediate_tol : 0.0,
+                     k > 0 ? warm_max_iter : 0);
     res.comp_residual = comp_residual(it_.x.data(), residual_pairs_);
     record(res, r, k, sigma);
     if (on_row) on_row(res.rows.back());
