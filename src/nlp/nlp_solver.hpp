@@ -17,14 +17,21 @@ struct Iterate {
 };
 
 struct NlpResult {
-  bool success = false;       ///< converged (to tol or acceptable_tol)
-  bool eval_error = false;    ///< stopped because evaluations kept failing (NaN/inf)
-  std::string status;         ///< backend status name, e.g. "Solve_Succeeded"
-  std::string linear_solver;  ///< KKT solver used: "dense" (LAPACK LDL') or "mumps"
+  bool success = false;     ///< converged (to tol or acceptable_tol)
+  bool eval_error = false;  ///< stopped because evaluations kept failing (NaN/inf)
+  std::string status;       ///< backend status name, e.g. "Solve_Succeeded"
+  /// KKT solver that produced the result: "dense" (LAPACK LDL'), "sparse_ldl", "mumps", "mumps
+  /// (sparse_ldl fallback)" (sparse_ldl failed, MUMPS solved again from the same start), or
+  /// IPOPT's linear_solver when the caller set that.
+  std::string linear_solver;
   int iterations = 0;
   double objective = 0, inf_pr = 0, inf_du = 0;
   double eval_s = 0;   ///< time spent in function and derivative evaluations
   double total_s = 0;  ///< wall time of the whole solve
+  /// Wall time in IPOPT's factorizations (its LinearSystemFactorization timer), and the number of
+  /// factorizations when fesd's KKT module ran them (0 with MUMPS). Of the run reported.
+  double factor_s = 0;
+  long long factorizations = 0;
 };
 
 class NlpSolver {
