@@ -10,6 +10,7 @@
 #include "nlp/kkt/kkt_module.h"
 
 #include <algorithm>
+#include <vector>
 
 #include "nlp/kkt/dense_ldl.hpp"
 #include "nlp/kkt/sparse_ldl.hpp"
@@ -23,7 +24,46 @@ constexpr int kStepsSparse = 2;
 
 thread_local int requested_mode = FESD_KKT_AUTO;
 thread_local FesdKktStats stats{};
+
+/// Matrices kept for benchmarks (fesd_kkt_capture).
+struct Captured {
+  int n = 0;
+  std::vector<int> irn, icn;
+  std::vector<double> values;
+};
+struct Capture {
+  int stride = 0, max_count = 0;
+  long long seen = 0;
+  std::vector<Captured> matrices;
+};
+thread_local Capture capture;
+
+void maybe_capture(int n, int nz, const int* irn, const int* icn, const double* a) {
+  if (capture.stride <= 0 || static_cast<int>(capture.matrices.size()) >= capture.max_count) return;
+  if (capture.seen++ % capture.stride != 0) return;
+  capture.matrices.push_back(Captured{n, std::vector<int>(irn, irn + nz),
+                                      std::vector<int>(icn, icn + nz),
+                                      std::vector<double>(a, a + nz)});
+}
 }  // namespace
+
+FESD_KKT_EXPORT void fesd_kkt_capture(int stride, int max_count) {
+  capture = Capture{stride, max_count, 0, {}};
+}
+
+FESD_KKT_EXPORT int fesd_kkt_captured_count(void) {
+  return static_cast<int>(capture.matrices.size());
+}
+
+FESD_KKT_EXPORT void fesd_kkt_captured(int i, int* n, int* nz, const int** irn, const int** icn,
+                                       const double** values) {
+  const Captured& c = capture.matrices.at(static_cast<std::size_t>(i));
+  *n = c.n;
+  *nz = static_cast<int>(c.values.size());
+  *irn = c.irn.data();
+  *icn = c.icn.data();
+  *values = c.values.data();
+}
 
 FESD_KKT_EXPORT void fesd_kkt_request_mode(int mode) {
   requested_mode = mode;
@@ -60,6 +100,7 @@ FESD_KKT_EXPORT void ma27ad_(const int* n, const int* nz, const int* irn, const 
 FESD_KKT_EXPORT void ma27bd_(const int* n, const int* nz, const int* irn, const int* icn, double* a,
                              const int* la, int* iw, const int* liw, int* ikeep, int* nsteps,
                              int* maxfrt, int*, int*, double* cntl, int* info) {
+  if (*nsteps == kStepsSparse) maybe_capture(*n, *nz, irn, icn, a);
   if (*nsteps == kStepsSparse)
     fesd::kkt::sparse_factor(*n, *nz, irn, icn, a, *la, iw, *liw, ikeep, maxfrt, cntl[0], info,
                              &stats);

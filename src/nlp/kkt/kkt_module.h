@@ -35,6 +35,15 @@ struct FesdKktStats {
 void fesd_kkt_stats(struct FesdKktStats* out);
 void fesd_kkt_reset_stats(void);
 
+/* For benchmarks: from now on keep a copy of every stride-th matrix the sparse factorization gets
+ * on this thread, at most max_count of them (0 stops and frees them). */
+void fesd_kkt_capture(int stride, int max_count);
+int fesd_kkt_captured_count(void);
+/* The i-th captured matrix: order, entries, 1-based triplets (IPOPT's lower triangle) and
+ * values; the pointers stay valid until the next fesd_kkt_capture call. */
+void fesd_kkt_captured(int i, int* n, int* nz, const int** irn, const int** icn,
+                       const double** values);
+
 #ifdef __cplusplus
 }
 #endif

@@ -32,6 +32,7 @@
 #include <amd.h>
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -45,15 +46,18 @@ using Index = std::int64_t;
 
 constexpr int kInfo = 20;
 constexpr int kMagic = 0x46544b4b;  // IW[0]: the factor in IW/A is ours
-constexpr int kHeader = 8;          // IW header length
+constexpr int kHeader = 16;         // IW header length
 // IKEEP[2N]: whether IKEEP[0..N) holds the value-based ordering yet (MA27AD has no values).
 constexpr int kOrderingPending = 0;
 constexpr int kOrderingReady = 1;
 /// Largest number of columns merged into one supernode (a chain of the elimination tree).
-constexpr int kMaxSupernodeCols = 32;
-/// Relaxed amalgamation: a front and its parent's merge while they have at most this many
-/// columns together.
-constexpr int kAmalgamateCols = 16;
+constexpr int kMaxSupernodeCols = 48;
+/// Relaxed amalgamation: a front merges into its parent's if together they have at most max_cols
+/// columns and a fraction below max_zeros of the merged front's entries are explicit zeros.
+struct Relax {
+  double max_cols, max_zeros;
+};
+constexpr Relax kRelax[] = {{8, 1.0}, {16, 0.3}, {48, 0.05}};
 /// A pivot (1x1) or a 2x2 pivot's determinant scale below this fraction of the scaled matrix's
 /// largest entry counts as zero.
 constexpr double kTinyRel = 1e-14;
@@ -69,7 +73,66 @@ constexpr int kMaxRefine = 3;
 constexpr double kBerrTarget = 1e-14;
 
 // IW header slots.
-enum Header { kHMagic = 0, kHN, kHNz, kHFronts, kHFirst, kHEnd, kHMaxFront, kHSpare };
+enum Header {
+  kHMagic = 0,
+  kHN,
+  kHNz,
+  kHFronts,    // number of front records
+  kHFirst,     // offset of the first front record
+  kHEnd,       // end of the front records
+  kHMaxFront,  // largest front
+  kHSymbolic,  // offset of the symbolic analysis (layout: Symbolic)
+  kHEntries,   // entries of the permuted lower triangle (duplicates kept)
+  kHSupernodes
+};
+// IKEEP[2N + 1 ..]: the symbolic analysis in IW is valid for this IW (address and length), so the
+// next factorization reuses it. IPOPT keeps IW between factorizations unless it reallocates it,
+// which changes LIW.
+enum KeepSlot { kKOrdering = 0, kKSymbolic, kKLiw, kKAddrLo, kKAddrHi, kKSlots };
+
+/// The structure-only part of the factorization, computed once per structure and kept in IW:
+/// arrays of ints behind these pointers.
+struct Symbolic {
+  const int* iperm;     // n: position of each row in the elimination order
+  const int* colptr;    // n + 1: entries of the permuted lower triangle by column
+  const int* crow;      //   their rows (permuted numbering)
+  const int* slot;      // nz: where triplet e goes in crow (-1: out of range)
+  const int* cols_ptr;  // ns + 1: each supernode's columns ...
+  const int* cols;      //   ... in elimination order (permuted numbering)
+  const int* sparent;   // ns: parent supernode, -1 at a root
+  const int* cptr;      // ns + 1: each supernode's children ...
+  const int* clist;     //   ... in increasing order
+  int ns = 0;
+};
+
+Index symbolic_length(int n, int nz, int entries, int ns) {
+  return static_cast<Index>(n) * 3 + 1 + entries + nz + 3 * static_cast<Index>(ns) + 2 + ns;
+}
+
+Symbolic symbolic_view(const int* iw) {
+  const int n = iw[kHN], nz = iw[kHNz], entries = iw[kHEntries], ns = iw[kHSupernodes];
+  Symbolic v;
+  const int* q = iw + iw[kHSymbolic];
+  v.iperm = q;
+  q += n;
+  v.colptr = q;
+  q += n + 1;
+  v.crow = q;
+  q += entries;
+  v.slot = q;
+  q += nz;
+  v.cols_ptr = q;
+  q += ns + 1;
+  v.cols = q;
+  q += n;
+  v.sparent = q;
+  q += ns;
+  v.cptr = q;
+  q += ns + 1;
+  v.clist = q;
+  v.ns = ns;
+  return v;
+}
 
 bool valid(int n, int i, int j) {
   return i >= 0 && i < n && j >= 0 && j < n;
@@ -217,8 +280,17 @@ struct PivotResult {
 /// the threshold test allows, moving accepted pivots to the front (idx follows). On return the
 /// first nelim columns hold L (D on the diagonal, a 2x2's off-diagonal at (k+1, k)), the trailing
 /// (nf - nelim) block the Schur complement. kind[k]: 1 = 1x1, 2 = first of a 2x2, 0 = second.
-PivotResult partial_ldlt(int nf, int nfs, double* storage, int* idx, int* kind, double u,
-                         double tiny, std::vector<double>& w1, std::vector<double>& w2) {
+// The kernels get an AVX2/FMA variant chosen at load time (the default build targets plain
+// x86-64).
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define FESD_KKT_KERNEL __attribute__((target_clones("arch=x86-64-v3", "default")))
+#else
+#define FESD_KKT_KERNEL
+#endif
+
+FESD_KKT_KERNEL PivotResult partial_ldlt(int nf, int nfs, double* storage, int* idx, int* kind,
+                                         double u, double tiny, std::vector<double>& w1,
+                                         std::vector<double>& w2) {
   Front F(storage, nf);
   PivotResult res;
   w1.resize(nf);
@@ -356,8 +428,20 @@ struct Contribution {
   int ndelayed = 0;
 };
 
+/// Scratch memory of the factorization, kept per thread between calls (it holds no state: every
+/// call overwrites what it uses). Allocating it per call cost more than the factorization of a
+/// ~3000-row KKT matrix: glibc returned the freed memory to the kernel and the next call paid
+/// page faults again.
+struct Workspace {
+  std::vector<double> rmax, cval, front, w1, w2;
+  std::vector<int> pos, fidx, kind, lp;
+  std::vector<Contribution> cb;
+  std::vector<std::vector<double>> pool;
+};
+thread_local Workspace ws;
+
 /// Applies the factor to v in place: v <- S (L D L')^-1 S v.
-void apply_inverse(const double* a, const int* iw, double* v, double* w) {
+FESD_KKT_KERNEL void apply_inverse(const double* a, const int* iw, double* v, double* w) {
   const int n = iw[kHN], nz = iw[kHNz];
   const double* scale = a + nz;
   for (int i = 0; i < n; ++i) v[i] *= scale[i];
@@ -432,6 +516,17 @@ void apply_inverse(const double* a, const int* iw, double* v, double* w) {
   for (int i = 0; i < n; ++i) v[i] *= scale[i];
 }
 
+/// 2^-floor(e / 2) for v = m 2^e (1 <= m < 2): about 1 / sqrt(v), a power of two; 1 for zero,
+/// subnormal, infinite or NaN v.
+double inverse_sqrt_pow2(double v) {
+  const auto bits = std::bit_cast<std::uint64_t>(v);
+  const int biased = static_cast<int>((bits >> 52) & 0x7ff);
+  if (biased == 0 || biased == 0x7ff) return 1.0;
+  const int e = biased - 1023;
+  const int half = e >= 0 ? e / 2 : -((1 - e) / 2);  // floor(e / 2)
+  return std::bit_cast<double>(static_cast<std::uint64_t>(1023 - half) << 52);
+}
+
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -462,67 +557,15 @@ void sparse_analyse(int n, int nz, const int* irn, const int* icn, int* ikeep, i
   info[5] = static_cast<int>(std::min(liw, cap));  // NIRNEC
 }
 
-void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int la, int* iw,
-                   int liw, int* ikeep, int* maxfrt, double pivtol, int* info,
-                   FesdKktStats* stats) {
-  const auto t0 = std::chrono::steady_clock::now();
-  std::fill_n(info, kInfo, 0);
-  const Index fixed_la = static_cast<Index>(nz) + n;
-  const Index fixed_liw = kHeader + 2 * static_cast<Index>(nz);
-  if (la < fixed_la) {
-    info[0] = -4;
-    info[1] = static_cast<int>(fixed_la + 2 * static_cast<Index>(nz) + 20 * static_cast<Index>(n));
-    return;
-  }
-  if (liw < fixed_liw) {
-    info[0] = -3;
-    info[1] = static_cast<int>(fixed_liw + 4 * static_cast<Index>(n) + nz);
-    return;
-  }
-  iw[kHMagic] = kMagic;
-  iw[kHN] = n;
-  iw[kHNz] = nz;
-  iw[kHFronts] = 0;
-  iw[kHFirst] = static_cast<int>(fixed_liw);
-  iw[kHEnd] = static_cast<int>(fixed_liw);
-  iw[kHMaxFront] = 0;
-  iw[kHSpare] = 0;
-  *maxfrt = 1;
-  for (int e = 0; e < nz; ++e) {
-    const bool ok = valid(n, irn[e] - 1, icn[e] - 1);
-    iw[kHeader + e] = ok ? irn[e] - 1 : -1;
-    iw[kHeader + nz + e] = ok ? icn[e] - 1 : -1;
-  }
-  if (n == 0) return;
-
-  if (ikeep[2 * n] != kOrderingReady) {
-    compute_ordering(n, nz, irn, icn, a, ikeep);
-    ikeep[2 * n] = kOrderingReady;
-  }
-  const int* perm = ikeep;
+/// Builds the symbolic analysis for the ordering in ikeep and writes it to IW at iw_at (the
+/// header gets its offset and sizes). Returns the IW length it needs; writes nothing if liw is
+/// too short.
+Index build_symbolic(int n, int nz, const int* irn, const int* icn, const int* perm, int* iw,
+                     Index iw_at, Index liw) {
   std::vector<int> iperm(n);
   for (int k = 0; k < n; ++k) iperm[perm[k]] = k;
-
-  // Equilibration: S A S with S = scale, three Ruiz sweeps (max-norm of the rows).
-  double* scale = a + nz;
-  std::fill_n(scale, n, 1.0);
-  {
-    std::vector<double> rmax(n);
-    for (int sweep = 0; sweep < 3; ++sweep) {
-      std::fill(rmax.begin(), rmax.end(), 0.0);
-      for (int e = 0; e < nz; ++e) {
-        const int i = irn[e] - 1, j = icn[e] - 1;
-        if (!valid(n, i, j)) continue;
-        const double v = std::abs(a[e]) * scale[i] * scale[j];
-        rmax[i] = std::max(rmax[i], v);
-        rmax[j] = std::max(rmax[j], v);
-      }
-      for (int i = 0; i < n; ++i)
-        if (rmax[i] > 0) scale[i] /= std::sqrt(rmax[i]);
-    }
-  }
-
-  // Scaled entries by permuted column c = min, row r = max (lower triangle of P A P').
+  // Entries by permuted column c = min, row r = max (lower triangle of P A P'); and by row for
+  // the elimination tree.
   std::vector<int> colptr(static_cast<std::size_t>(n) + 1, 0), rowptr(colptr);
   for (int e = 0; e < nz; ++e) {
     const int i = irn[e] - 1, j = icn[e] - 1;
@@ -535,9 +578,7 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
     colptr[k + 1] += colptr[k];
     rowptr[k + 1] += rowptr[k];
   }
-  std::vector<int> crow(static_cast<std::size_t>(colptr[n])), rcol(rowptr[n]);
-  std::vector<double> cval(crow.size());
-  double amax = 0.0;
+  std::vector<int> crow(static_cast<std::size_t>(colptr[n])), rcol(rowptr[n]), slot(nz, -1);
   {
     std::vector<int> cnext(colptr.begin(), colptr.end() - 1),
         rnext(rowptr.begin(), rowptr.end() - 1);
@@ -545,16 +586,11 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
       const int i = irn[e] - 1, j = icn[e] - 1;
       if (!valid(n, i, j)) continue;
       const int r = std::max(iperm[i], iperm[j]), c = std::min(iperm[i], iperm[j]);
-      const double v = a[e] * scale[i] * scale[j];
-      amax = std::max(amax, std::abs(v));
-      crow[cnext[c]] = r;
-      cval[cnext[c]++] = v;
+      slot[e] = cnext[c];
+      crow[cnext[c]++] = r;
       if (r != c) rcol[rnext[r]++] = c;
     }
   }
-  const double tiny = kTinyRel * std::max(amax, std::numeric_limits<double>::min());
-  const double u = std::clamp(pivtol, kMinPivtol, kMaxPivtol);
-
   // Elimination tree (Liu's algorithm with path compression).
   std::vector<int> parent(n, -1), ancestor(n, -1), nchild(n, 0);
   for (int k = 0; k < n; ++k)
@@ -590,14 +626,17 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
   chain_start.push_back(n);
   for (int c = 0; c < nchains; ++c)
     for (int j = chain_start[c]; j < chain_start[c + 1]; ++j) chain_of[j] = c;
-  // Relaxed amalgamation: a chain joins its parent's front while both together have at most
-  // kAmalgamateCols columns. The fronts of these KKT matrices are small (tens of rows) and
-  // per-front work (assembly, index lists, the solve's gathers) dominated with one or two columns a
-  // front.
-  std::vector<int> rep(nchains), ncols(nchains);
+  // Relaxed amalgamation: a chain joins its parent's front when the explicit zeros this adds stay
+  // a small fraction of the merged front (more zeros allowed for few columns). One or two columns
+  // a front left the per-front work (assembly, index lists, the solve's gathers) dominant; merging
+  // up to 16 columns regardless of zeros doubled |L| and the flops.
+  std::vector<int> rep(nchains), ncols(nchains), below(nchains);
+  std::vector<double> true_nnz(nchains, 0.0);
   for (int c = 0; c < nchains; ++c) {
     rep[c] = c;
     ncols[c] = chain_start[c + 1] - chain_start[c];
+    below[c] = colcount[chain_start[c]] - ncols[c];
+    for (int j = chain_start[c]; j < chain_start[c + 1]; ++j) true_nnz[c] += colcount[j];
   }
   const auto find = [&](int c) {
     while (rep[c] != c) c = rep[c] = rep[rep[c]];
@@ -607,9 +646,16 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
     const int last = chain_start[c + 1] - 1;
     if (parent[last] < 0) continue;
     const int p = find(chain_of[parent[last]]);
-    if (ncols[c] + ncols[p] <= kAmalgamateCols) {
+    const double k = ncols[c] + ncols[p];
+    if (k > kMaxSupernodeCols) continue;
+    const double stored = k * (k + 1) / 2 + k * below[p];
+    const double zeros = 1.0 - (true_nnz[c] + true_nnz[p]) / stored;
+    bool merge = false;
+    for (const Relax& r : kRelax) merge = merge || (k <= r.max_cols && zeros < r.max_zeros);
+    if (merge) {
       rep[c] = p;
       ncols[p] += ncols[c];
+      true_nnz[p] += true_nnz[c];
     }
   }
   // Supernodes: the amalgamated chains, numbered by their last column (children first), each
@@ -642,17 +688,136 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
       if (sparent[s] >= 0) clist[next[sparent[s]]++] = s;
   }
 
+  const int entries = colptr[n];
+  const Index need = symbolic_length(n, nz, entries, ns);
+  if (iw_at + need > liw) return iw_at + need;
+  iw[kHSymbolic] = static_cast<int>(iw_at);
+  iw[kHEntries] = entries;
+  iw[kHSupernodes] = ns;
+  int* q = iw + iw_at;
+  for (const std::vector<int>* v :
+       {&iperm, &colptr, &crow, &slot, &cols_ptr, &cols, &sparent, &cptr, &clist})
+    q = std::copy(v->begin(), v->end(), q);
+  return iw_at + need;
+}
+
+void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int la, int* iw,
+                   int liw, int* ikeep, int* maxfrt, double pivtol, int* info,
+                   FesdKktStats* stats) {
+  const auto t0 = std::chrono::steady_clock::now();
+  std::fill_n(info, kInfo, 0);
+  const Index fixed_la = static_cast<Index>(nz) + n;
+  const Index pattern_end = kHeader + 2 * static_cast<Index>(nz);
+  if (la < fixed_la) {
+    info[0] = -4;
+    info[1] = static_cast<int>(fixed_la + 2 * static_cast<Index>(nz) + 20 * static_cast<Index>(n));
+    return;
+  }
+  if (liw < pattern_end) {
+    info[0] = -3;
+    info[1] = static_cast<int>(pattern_end + 4 * static_cast<Index>(n) + 2 * nz);
+    return;
+  }
+  *maxfrt = 1;
+  int* keep = n > 0 ? ikeep + 2 * n : nullptr;
+  const auto addr = reinterpret_cast<std::uintptr_t>(iw);
+  const int addr_lo = static_cast<int>(addr & 0x7fffffffU), addr_hi = static_cast<int>(addr >> 31);
+  const bool cached = n >= kKSlots && keep[kKOrdering] == kOrderingReady && keep[kKSymbolic] == 1 &&
+                      keep[kKLiw] == liw && keep[kKAddrLo] == addr_lo &&
+                      keep[kKAddrHi] == addr_hi && iw[kHMagic] == kMagic && iw[kHN] == n &&
+                      iw[kHNz] == nz;
+  if (!cached) {
+    if (n >= kKSlots) keep[kKSymbolic] = 0;
+    iw[kHMagic] = kMagic;
+    iw[kHN] = n;
+    iw[kHNz] = nz;
+    for (int e = 0; e < nz; ++e) {
+      const bool ok = valid(n, irn[e] - 1, icn[e] - 1);
+      iw[kHeader + e] = ok ? irn[e] - 1 : -1;
+      iw[kHeader + nz + e] = ok ? icn[e] - 1 : -1;
+    }
+  }
+  iw[kHFronts] = 0;
+  iw[kHFirst] = iw[kHEnd] = static_cast<int>(pattern_end);
+  iw[kHMaxFront] = 0;
+  if (n == 0) return;
+  if (!cached) {
+    if (keep[kKOrdering] != kOrderingReady) {
+      compute_ordering(n, nz, irn, icn, a, ikeep);
+      keep[kKOrdering] = kOrderingReady;
+    }
+    const Index end = build_symbolic(n, nz, irn, icn, ikeep, iw, pattern_end, liw);
+    if (end > liw) {
+      info[0] = -3;
+      info[1] =
+          static_cast<int>(std::min<Index>(end + end / 2, std::numeric_limits<int>::max() / 4));
+      return;
+    }
+    if (n >= kKSlots) {
+      keep[kKSymbolic] = 1;
+      keep[kKLiw] = liw;
+      keep[kKAddrLo] = addr_lo;
+      keep[kKAddrHi] = addr_hi;
+    }
+  }
+  const Symbolic sym = symbolic_view(iw);
+  const Index fixed_liw = iw[kHSymbolic] + symbolic_length(n, nz, iw[kHEntries], sym.ns);
+  iw[kHFirst] = iw[kHEnd] = static_cast<int>(fixed_liw);
+  const int* perm = ikeep;
+  const int *colptr = sym.colptr, *crow = sym.crow, *cols_ptr = sym.cols_ptr, *cols = sym.cols,
+            *sparent = sym.sparent, *cptr = sym.cptr, *clist = sym.clist;
+  const int ns = sym.ns;
+
+  // Equilibration: S A S with S = scale, three Ruiz sweeps (max-norm of the rows), each factor
+  // rounded to a power of two: the scaled matrix is exact, and no sqrt or division per row (they
+  // were a quarter of the work outside the fronts).
+  double* scale = a + nz;
+  std::fill_n(scale, n, 1.0);
+  {
+    std::vector<double>& rmax = ws.rmax;
+    rmax.resize(n);
+    for (int sweep = 0; sweep < 3; ++sweep) {
+      std::fill(rmax.begin(), rmax.end(), 0.0);
+      for (int e = 0; e < nz; ++e) {
+        const int i = irn[e] - 1, j = icn[e] - 1;
+        if (!valid(n, i, j)) continue;
+        const double v = std::abs(a[e]) * scale[i] * scale[j];
+        rmax[i] = std::max(rmax[i], v);
+        rmax[j] = std::max(rmax[j], v);
+      }
+      for (int i = 0; i < n; ++i) scale[i] *= inverse_sqrt_pow2(rmax[i]);
+    }
+  }
+
+  // Scaled values in the permuted lower triangle.
+  std::vector<double>& cval = ws.cval;
+  cval.assign(static_cast<std::size_t>(iw[kHEntries]), 0.0);
+  double amax = 0.0;
+  for (int e = 0; e < nz; ++e) {
+    if (sym.slot[e] < 0) continue;
+    const double v = a[e] * scale[irn[e] - 1] * scale[icn[e] - 1];
+    amax = std::max(amax, std::abs(v));
+    cval[sym.slot[e]] = v;
+  }
+  const double tiny = kTinyRel * std::max(amax, std::numeric_limits<double>::min());
+  const double u = std::clamp(pivtol, kMinPivtol, kMaxPivtol);
+
   // Multifrontal factorization; children (smaller last columns) come before their parent.
-  std::vector<int> pos(n, -1), fidx, kind;
-  std::vector<double> front, w1, w2;
-  std::vector<Contribution> cb(ns);
-  std::vector<std::vector<double>> pool;  // contribution buffers, reused
+  std::vector<int>&pos = ws.pos, &fidx = ws.fidx, &kind = ws.kind;
+  pos.assign(n, -1);
+  std::vector<double>&front = ws.front, &w1 = ws.w1, &w2 = ws.w2;
+  std::vector<int>& w_pos = ws.lp;
+  std::vector<Contribution>& cb = ws.cb;
+  for (Contribution& c : cb)
+    if (c.val.capacity() > 0) ws.pool.push_back(std::move(c.val));
+  cb.assign(ns, Contribution{});
+  std::vector<std::vector<double>>& pool = ws.pool;
   Index a_next = fixed_la, iw_next = fixed_liw;
   int negative = 0, rank = n, maxnf = 0, nfronts = 0;
   long long delayed = 0;
   bool singular = false;
   for (int s = 0; s < ns; ++s) {
-    const int* own = cols.data() + cols_ptr[s];
+    const int* own = cols + cols_ptr[s];
     const int nown = cols_ptr[s + 1] - cols_ptr[s];
     fidx.clear();
     auto add = [&](int g) {
@@ -671,23 +836,39 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
     for (int p = cptr[s]; p < cptr[s + 1]; ++p)
       for (int g : cb[clist[p]].idx) add(g);
     const int nf = static_cast<int>(fidx.size());
+    // Front order: own columns ascending, delayed pivots, then the other rows ascending. A child's
+    // rows other than its delayed ones are ascending too, so they land in ascending positions:
+    // the extend-add below needs no per-entry triangle test for them.
+    std::sort(fidx.begin() + nfs, fidx.end());
+    for (int i = nfs; i < nf; ++i) pos[fidx[i]] = i;
     maxnf = std::max(maxnf, nf);
     front.assign(static_cast<std::size_t>(nf) * nf, 0.0);
-    auto F = [&](int i, int j) -> double& {
-      if (i < j) std::swap(i, j);
-      return front[static_cast<std::size_t>(j) * nf + i];
-    };
+    double* fr = front.data();
     for (int t = 0; t < nown; ++t) {
       const int c = own[t];
-      for (int p = colptr[c]; p < colptr[c + 1]; ++p) F(pos[crow[p]], pos[c]) += cval[p];
+      double* fc = fr + static_cast<std::size_t>(pos[c]) * nf;
+      for (int p = colptr[c]; p < colptr[c + 1]; ++p) fc[pos[crow[p]]] += cval[p];
     }
     for (int p = cptr[s]; p < cptr[s + 1]; ++p) {
       Contribution& ch = cb[clist[p]];
       const int m = static_cast<int>(ch.idx.size());
+      std::vector<int>& lp = w_pos;
+      lp.resize(m);
+      for (int b = 0; b < m; ++b) lp[b] = pos[ch.idx[b]];
       for (int jb = 0; jb < m; ++jb) {
-        const int pj = pos[ch.idx[jb]];
+        const int pj = lp[jb];
         const double* col = ch.val.data() + static_cast<std::size_t>(jb) * m;
-        for (int ib = jb; ib < m; ++ib) F(pos[ch.idx[ib]], pj) += col[ib];
+        if (jb < ch.ndelayed) {
+          for (int ib = jb; ib < m; ++ib) {
+            const int pi = lp[ib];
+            const auto at = pi >= pj ? static_cast<std::size_t>(pj) * nf + pi
+                                     : static_cast<std::size_t>(pi) * nf + pj;
+            fr[at] += col[ib];
+          }
+        } else {
+          double* fc = fr + static_cast<std::size_t>(pj) * nf;
+          for (int ib = jb; ib < m; ++ib) fc[lp[ib]] += col[ib];
+        }
       }
       pool.push_back(std::move(ch.val));
       ch = Contribution{};
