@@ -189,6 +189,8 @@ struct Row {
   double s_per_iter = 0, factor_s_per_iter = 0, objective = NAN;
   long long factorizations = 0;
   double factor_s_per_call = NAN;  // fesd's module only (its own count)
+  long long solves = 0, refinements = 0, delayed = 0;
+  double solve_s_per_iter = NAN;
 };
 
 struct Direct {
@@ -280,6 +282,10 @@ int main(int argc, char** argv) {
         kkt_rows = after.last_n;
         row.factor_s_per_call = (after.factor_seconds - before.factor_seconds) /
                                 static_cast<double>(std::max(1LL, row.factorizations));
+        row.solves = after.solves - before.solves;
+        row.refinements = after.refinement_steps - before.refinement_steps;
+        row.delayed = after.delayed_pivots - before.delayed_pivots;
+        row.solve_s_per_iter = (after.solve_seconds - before.solve_seconds) / it;
         for (int i = 0; i < module.captured_count(); ++i) {
           Matrix m;
           const int *irn = nullptr, *icn = nullptr;
@@ -301,6 +307,13 @@ int main(int argc, char** argv) {
                      : fmt::format("{:.3f}", 1e3 * row.factor_s_per_iter),
                  row.factorizations,
                  capture ? fmt::format("{:.3f}", 1e3 * row.factor_s_per_call) : "", row.objective);
+      if (capture)
+        fmt::print(
+            "{:>20} solves {} ({:.3f} ms/iter), refinement steps {}, delayed pivots {:.1f} "
+            "per factorization\n",
+            "", row.solves, 1e3 * row.solve_s_per_iter, row.refinements,
+            static_cast<double>(row.delayed) /
+                static_cast<double>(std::max(1LL, row.factorizations)));
       std::fflush(stdout);
       rows.push_back(row);
     }
@@ -329,11 +342,13 @@ int main(int argc, char** argv) {
   if (!csv.empty()) {
     std::ofstream os(csv);
     os << "N_stages,solver,n_variables,n_constraints,kkt_rows,iterations,s_per_iteration,"
-          "factor_s_per_iteration,factorizations,factor_s_per_call,objective,status\n";
+          "factor_s_per_iteration,factorizations,factor_s_per_call,solves,solve_s_per_iteration,"
+          "refinement_steps,delayed_pivots,objective,status\n";
     for (const Row& r : rows)
-      os << fmt::format("{},{},{},{},{},{},{:.6g},{:.6g},{},{:.6g},{:.12g},{}\n", r.N_stages,
-                        r.solver, r.n_vars, r.n_cons, r.kkt_rows, r.iterations, r.s_per_iter,
-                        r.factor_s_per_iter, r.factorizations, r.factor_s_per_call, r.objective,
+      os << fmt::format("{},{},{},{},{},{},{:.6g},{:.6g},{},{:.6g},{},{:.6g},{},{},{:.12g},{}\n",
+                        r.N_stages, r.solver, r.n_vars, r.n_cons, r.kkt_rows, r.iterations,
+                        r.s_per_iter, r.factor_s_per_iter, r.factorizations, r.factor_s_per_call,
+                        r.solves, r.solve_s_per_iter, r.refinements, r.delayed, r.objective,
                         r.status);
     os << "\nN_stages,kkt_rows,matrices,sparse_ldl_factor_s,mumps_factor_s\n";
     for (const Direct& d : direct)
@@ -352,6 +367,11 @@ int main(int argc, char** argv) {
                            {"s_per_iteration", r.s_per_iter},
                            {"factor_s_per_iteration", r.factor_s_per_iter},
                            {"factorizations", r.factorizations},
+                           {"factor_s_per_call", r.factor_s_per_call},
+                           {"solves", r.solves},
+                           {"solve_s_per_iteration", r.solve_s_per_iter},
+                           {"refinement_steps", r.refinements},
+                           {"delayed_pivots", r.delayed},
                            {"objective", r.objective},
                            {"status", r.status}});
     for (const Direct& d : direct)

@@ -1,5 +1,6 @@
-// src/nlp/nlp_solver.hpp: the small interface the MPCC layer solves NLPs through. IPOPT + MUMPS is
-// the one backend today; a structure-exploiting solver can replace it behind this interface.
+// src/nlp/nlp_solver.hpp: the small interface the MPCC layer solves NLPs through. IPOPT (its KKT
+// systems solved by fesd's module or MUMPS) is the one backend today; a structure-exploiting solver
+// can replace it behind this interface.
 #pragma once
 #include <memory>
 #include <string>
@@ -45,7 +46,7 @@ class NlpSolver {
                           int max_iter) = 0;
 };
 
-/// The NLP solver every front end uses: IPOPT + MUMPS (or the dense KKT module for small NLPs).
+/// The NLP solver every front end uses: IPOPT with fesd's KKT module or MUMPS (kkt_solver).
 /// One factory, so that another backend can replace IPOPT without touching a front end. Throws
 /// fesd::InvalidOption if the backend rejects an option (the message names it).
 std::unique_ptr<NlpSolver> make_solver(const NlpOptions& options);
