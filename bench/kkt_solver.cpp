@@ -279,7 +279,6 @@ int main(int argc, char** argv) {
       row.s_per_iter = wall / it;
       row.factor_s_per_iter = factor_s / it;
       if (capture) {
-        kkt_rows = after.last_n;
         row.factor_s_per_call = (after.factor_seconds - before.factor_seconds) /
                                 static_cast<double>(std::max(1LL, row.factorizations));
         row.solves = after.solves - before.solves;
@@ -297,6 +296,8 @@ int main(int argc, char** argv) {
           captured.push_back(std::move(m));
         }
         module.capture(0, 0);
+        // The main NLP's KKT order (the last matrix may be a smaller re-solve's).
+        if (!captured.empty()) kkt_rows = captured.front().n;
       }
       row.kkt_rows = kkt_rows;
       fmt::print("{:>8} {:>11} {:>6} {:>6} {:>6} {:>6} {:>11.3f} {:>12} {:>8} {:>13} {:>16.10g}\n",
