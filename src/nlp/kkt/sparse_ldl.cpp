@@ -9,10 +9,11 @@
 //    entry, the pair becomes one node, and AMD (SuiteSparse) orders the compressed graph; a pair is
 //    eliminated as (its nonzero-diagonal row, then the zero-diagonal row). Plain AMD put constraint
 //    rows before their variables and delayed a pivot on almost every constraint.
-//  - Symmetric equilibration (three Ruiz sweeps, as the dense solver): inertia is kept by
-//    congruence and the pivot tests become scale-free.
-//  - Elimination tree (Liu), supernodes = chains of the tree of at most kMaxSupernodeCols
-//    columns, multifrontal factorization in tree order with dense fronts.
+//  - Symmetric equilibration (three Ruiz sweeps, factors rounded to powers of two): inertia is
+//    kept by congruence and the pivot tests become scale-free.
+//  - Elimination tree (Liu), column counts, supernodes = chains of the tree, relaxed amalgamation
+//    (kRelax); multifrontal factorization in tree order with dense fronts. Computed once per
+//    structure and kept in IW while IPOPT keeps IW.
 //  - In a front: threshold pivoting among the fully summed rows, 1x1 if |d| >= u * column max,
 //    else a 2x2 with the largest fully summed entry of the column if |D^-1| bounds the growth by
 //    1/u; u = IPOPT's ma27_pivtol (CNTL(1)). Pivots that fail move up to the parent front
@@ -21,12 +22,13 @@
 //  - Inertia: negative eigenvalues of D (1x1 by sign, 2x2 by determinant and trace), exact by
 //    Sylvester's law.
 //  - Solve: forward / diagonal / backward over the fronts, then iterative refinement on the
-//    residual of the unscaled matrix until the componentwise backward error is <= kBerrTarget.
+//    residual of the unscaled matrix until the normwise backward error is <= kBerrTarget.
 //
-// Storage: all state is in the arrays IPOPT owns. IKEEP = [ordering (N) | unused (N) | flag, ..],
-// A = [values (NZ) | scaling (N) | per front its nf x nelim block of L with D on the diagonal and
-// a 2x2 pivot's off-diagonal at L(k+1, k)], IW = [header | pattern (2 NZ) | per front: nf, nelim,
-// offset in A, nf indices, nelim pivot kinds, record start].
+// Storage: all state is in the arrays IPOPT owns. IKEEP = [ordering (N) | unused (N) | state
+// (KeepSlot)], A = [values (NZ) | scaling (N) | per front its nf x nelim block of L with D on the
+// diagonal and a 2x2 pivot's off-diagonal at L(k+1, k)], IW = [header | pattern (2 NZ) | symbolic
+// analysis (Symbolic) | per front: nf, nelim, offset in A, nf indices, nelim pivot kinds, record
+// start]. Per-thread scratch memory (Workspace) holds no state between calls.
 #include "nlp/kkt/sparse_ldl.hpp"
 
 #include <amd.h>
