@@ -2,7 +2,7 @@
 # Installs the Debian 12 packages fesd needs (build, tests, plots). Safe to re-run.
 set -euo pipefail
 pkgs=(build-essential cmake pkg-config coinor-libipopt-dev libeigen3-dev libtomlplusplus-dev
-      nlohmann-json3-dev libcli11-dev libfmt-dev libgtest-dev liblapack-dev gnuplot-nox)
+      nlohmann-json3-dev libcli11-dev libfmt-dev libgtest-dev liblapack-dev libsuitesparse-dev gnuplot-nox)
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -139,12 +139,27 @@ struct HomotopyOptions {
   bool fix_active_set = true;
 };
 
+/// The linear solver behind IPOPT's KKT systems (docs/kkt-solver.md).
+enum class KktSolver {
+  Auto,       ///< dense LDL' for NLPs with n + m <= 128, the sparse LDL' above (default)
+  SparseLdl,  ///< fesd's sparse multifrontal LDL' at every size
+  Dense,      ///< fesd's dense LAPACK LDL' at every size (O((n + m)^3) per factorization)
+  Mumps,      ///< IPOPT's MUMPS
+};
+/// Problem-file key `kkt_solver`: "auto", "sparse_ldl", "dense", "mumps".
+std::string_view to_string(KktSolver v);
+bool parse(std::string_view name, KktSolver& out);
+
 /// IPOPT options (problem-file table [ipopt]). Any other IPOPT option can be passed by name.
 struct NlpOptions {
   double tol = 1e-12;            ///< `tol` > 0 (IPOPT's default 1e-8 cannot reach 1e-12 accuracy)
   double acceptable_tol = 1e-6;  ///< `acceptable_tol` > 0
   int max_iter = 500;            ///< `max_iter` >= 1, per NLP
   int print_level = 0;           ///< `print_level` 0..12 (IPOPT's own output)
+  /// `kkt_solver`: IPOPT's linear solver. An IPOPT `linear_solver` in `extra` overrides it. With
+  /// sparse_ldl (also under auto) an NLP that fails is solved again with MUMPS from the same
+  /// start, and NlpResult::linear_solver says "mumps (sparse_ldl fallback)".
+  KktSolver kkt_solver = KktSolver::Auto;
   /// Extra IPOPT options as (name, value) strings, e.g. {"mu_strategy", "monotone"}.
   std::vector<std::pair<std::string, std::string>> extra;
 };

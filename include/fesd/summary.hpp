@@ -24,8 +24,12 @@ struct HomotopyRow {
   int nlp_iterations = 0;
   std::string nlp_status;  ///< IPOPT's return status, e.g. "Solve_Succeeded"
   double cpu_s = 0;
-  /// KKT solver IPOPT used: "dense" (LAPACK LDL', small NLPs) or "mumps".
+  /// KKT solver IPOPT used: "dense" (LAPACK LDL', small NLPs), "sparse_ldl", "mumps", or "mumps
+  /// (sparse_ldl fallback)" (NlpOptions::kkt_solver).
   std::string linear_solver;
+  /// Wall time of IPOPT's KKT factorizations, and their number with fesd's sparse LDL' (0 else).
+  double factor_s = 0;
+  long long factorizations = 0;
   /// Not a homotopy step but the last NLP solved once more with the active set of every element
   /// fixed (HomotopyOptions::fix_active_set, or sliding exits to pin).
   bool active_set_fixed = false;

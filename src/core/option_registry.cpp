@@ -306,6 +306,8 @@ std::vector<Option> build() {
                                             "", at_least(1)));
   o.push_back(scalar<&T::nlp, &N::print_level>(kIpopt, "print_level", kBoth, "IPOPT's own output",
                                                "", between(0, 12)));
+  o.push_back(scalar<&T::nlp, &N::kkt_solver>(kIpopt, "kkt_solver", kBoth,
+                                              "linear solver of IPOPT's KKT systems", ""));
   return o;
 }
 

@@ -20,6 +20,7 @@ struct Ocp;
 struct OcpOptions;
 enum class TerminalConstraint;
 enum class OcpInitialization;
+enum class KktSolver;
 }  // namespace fesd
 
 namespace fesd::registry {
@@ -112,6 +113,8 @@ template <>
 std::span<const std::string_view> enum_names<TerminalConstraint>();
 template <>
 std::span<const std::string_view> enum_names<OcpInitialization>();
+template <>
+std::span<const std::string_view> enum_names<KktSolver>();
 
 /// Every option, table by table.
 std::span<const Option> all();

@@ -28,6 +28,7 @@ constexpr std::array<std::string_view, 5> kMpccMode{
 // nosnoc's relax_terminal_constraint values that fesd implements.
 constexpr std::array<std::string_view, 2> kTerminalConstraint{"none", "ell_1"};
 constexpr std::array<std::string_view, 2> kOcpInitialization{"constant", "simulation"};
+constexpr std::array<std::string_view, 4> kKktSolver{"auto", "sparse_ldl", "dense", "mumps"};
 
 template <class E, std::size_t K>
 std::string_view name_of(const std::array<std::string_view, K>& names, E v) {
@@ -80,6 +81,10 @@ std::span<const std::string_view> enum_names<TerminalConstraint>() {
 template <>
 std::span<const std::string_view> enum_names<OcpInitialization>() {
   return kOcpInitialization;
+}
+template <>
+std::span<const std::string_view> enum_names<KktSolver>() {
+  return kKktSolver;
 }
 }  // namespace registry
 
@@ -134,6 +139,12 @@ std::string_view to_string(OcpInitialization v) {
 }
 bool parse(std::string_view name, OcpInitialization& out) {
   return parse_from(kOcpInitialization, name, out);
+}
+std::string_view to_string(KktSolver v) {
+  return name_of(kKktSolver, v);
+}
+bool parse(std::string_view name, KktSolver& out) {
+  return parse_from(kKktSolver, name, out);
 }
 
 std::vector<std::string> validate(const DiscretizationOptions& o) {

@@ -85,7 +85,7 @@ std::string format_work(const Summary& s, double per_step) {
   const double busy = s.derivative_s + s.solver_s;
   out += fmt::format("    derivatives        {:.3f} s  ({:.0f} %)\n", s.derivative_s,
                      busy > 0 ? 100 * s.derivative_s / busy : 0.0);
-  out += fmt::format("    IPOPT + MUMPS      {:.3f} s  ({:.0f} %)\n", s.solver_s,
+  out += fmt::format("    IPOPT + KKT solve  {:.3f} s  ({:.0f} %)\n", s.solver_s,
                      busy > 0 ? 100 * s.solver_s / busy : 0.0);
   out += fmt::format("    setup              {:.3f} s\n", s.setup_s);
   return out;

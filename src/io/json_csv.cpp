@@ -112,6 +112,8 @@ json homotopy_row(const HomotopyRow& r) {
               {"nlp_status", r.nlp_status},
               {"cpu_s", number(r.cpu_s)},
               {"linear_solver", r.linear_solver},
+              {"factor_s", number(r.factor_s)},
+              {"factorizations", r.factorizations},
               {"active_set_fixed", r.active_set_fixed},
               {"pinned_exits", r.pinned_exits}};
 }

@@ -28,6 +28,8 @@ void record(HomotopyResult& res, const nlp::NlpResult& r, int k, double sigma) {
   row.nlp_status = r.status;
   row.cpu_s = r.total_s;
   row.linear_solver = r.linear_solver;
+  row.factor_s = r.factor_s;
+  row.factorizations = r.factorizations;
   res.rows.push_back(std::move(row));
   res.eval_s += r.eval_s;
   res.solver_s += r.total_s - r.eval_s;

@@ -12,11 +12,13 @@
 
 #include <fmt/format.h>
 #include <IpIpoptApplication.hpp>
+#include <IpIpoptData.hpp>
 #include <IpRegOptions.hpp>
 #include <IpSolveStatistics.hpp>
 #include <IpTNLP.hpp>
 
 #include "fesd/error.hpp"
+#include "nlp/kkt/kkt_module.h"
 
 namespace fesd::nlp {
 namespace {
@@ -177,21 +179,51 @@ class BlockTnlp final : public Ipopt::TNLP {
   int eval_failures_ = 0, iterations_ = 0;
 };
 
-/// Largest KKT dimension (n + m) solved with the dense LDL' solver; above it MUMPS. Dense costs
-/// (n + m)^3 / 3 flops per factorization, MUMPS a fixed ~0.5 ms per call (docs/benchmarks.md).
-constexpr int kDenseKktMax = 128;
+/// Largest n + m solved with the dense LDL' under kkt_solver = auto; above it the sparse LDL'.
+/// Dense costs (n + m)^3 / 3 flops per factorization (docs/benchmarks.md). The KKT matrix also
+/// has a row per inequality's slack, so this is decided here, on the NLP, not in the module.
+constexpr int kDenseKktMax = FESD_KKT_DENSE_MAX;
 
-/// Loads libfesd_dense_kkt.so (next to libfesd.so) globally, so that IPOPT's loader, which opens
+/// The KKT module's own entry points (kkt_module.h), found once its library is loaded.
+struct KktModule {
+  void (*request_mode)(int) = nullptr;
+  void (*stats)(FesdKktStats*) = nullptr;
+  bool ok() const { return request_mode != nullptr && stats != nullptr; }
+};
+
+/// Loads libfesd_kkt.so (next to libfesd.so) globally, so that IPOPT's loader, which opens
 /// "libhsl.so" for linear_solver = ma27, finds it by its SONAME. Once per process.
-bool load_dense_kkt() {
-  static const bool ok = [] {
+const KktModule& kkt_module() {
+  static const KktModule module = [] {
+    KktModule m;
     Dl_info info;
-    if (dladdr(reinterpret_cast<void*>(&load_dense_kkt), &info) == 0 || info.dli_fname == nullptr)
-      return false;
-    const auto path = std::filesystem::path(info.dli_fname).parent_path() / "libfesd_dense_kkt.so";
-    return dlopen(path.c_str(), RTLD_NOW | RTLD_GLOBAL) != nullptr;
+    if (dladdr(reinterpret_cast<void*>(&kkt_module), &info) == 0 || info.dli_fname == nullptr)
+      return m;
+    const auto path = std::filesystem::path(info.dli_fname).parent_path() / "libfesd_kkt.so";
+    void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_GLOBAL);
+    if (handle == nullptr) return m;
+    m.request_mode = reinterpret_cast<void (*)(int)>(dlsym(handle, "fesd_kkt_request_mode"));
+    m.stats = reinterpret_cast<void (*)(FesdKktStats*)>(dlsym(handle, "fesd_kkt_stats"));
+    return m;
   }();
-  return ok;
+  return module;
+}
+
+/// Whether a failed sparse_ldl solve is worth repeating with MUMPS: not when the outcome does not
+/// depend on the linear solver (limits, the caller's stop, bad input, evaluation errors).
+bool retry_with_mumps(Ipopt::ApplicationReturnStatus s) {
+  switch (s) {
+    case Ipopt::Maximum_Iterations_Exceeded:
+    case Ipopt::Maximum_CpuTime_Exceeded:
+    case Ipopt::User_Requested_Stop:
+    case Ipopt::Invalid_Option:
+    case Ipopt::Invalid_Problem_Definition:
+    case Ipopt::Not_Enough_Degrees_Of_Freedom:
+    case Ipopt::Infeasible_Problem_Detected:
+      return false;
+    default:
+      return true;
+  }
 }
 
 void set_option(Ipopt::IpoptApplication& app, const std::string& name, const std::string& value) {
@@ -230,8 +262,9 @@ void set_option(Ipopt::IpoptApplication& app, const std::string& name, const std
 struct IpoptSolver::Impl {
   Ipopt::SmartPtr<Ipopt::IpoptApplication> app;
   bool user_linear_solver = false;  // the caller chose IPOPT's linear_solver: never override it
-  double tol = 0;                   // the configured tol (NlpOptions::tol or [ipopt] extra)
-  int max_iter = 0;                 // the configured max_iter
+  KktSolver kkt_solver = KktSolver::Auto;
+  double tol = 0;    // the configured tol (NlpOptions::tol or [ipopt] extra)
+  int max_iter = 0;  // the configured max_iter
 };
 
 IpoptSolver::IpoptSolver(const NlpOptions& o) : impl_(std::make_unique<Impl>()) {
@@ -251,6 +284,7 @@ IpoptSolver::IpoptSolver(const NlpOptions& o) : impl_(std::make_unique<Impl>()) 
     set_option(app, name, value);
     if (name == "linear_solver") impl_->user_linear_solver = true;
   }
+  impl_->kkt_solver = o.kkt_solver;
   app.Options()->GetNumericValue("tol", impl_->tol, "");
   app.Options()->GetIntegerValue("max_iter", impl_->max_iter, "");
   // Initialize() without a file name would read the option_file_name option's file, by default
@@ -271,28 +305,74 @@ NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_star
       "max_iter", max_iter > 0 ? std::min(max_iter, impl_->max_iter) : impl_->max_iter);
   const bool warm = warm_start && start.has_duals();
   app.Options()->SetStringValue("warm_start_init_point", warm ? "yes" : "no");
-  std::string linear_solver;
+  // Which KKT solver: IPOPT's linear_solver if the caller set it, else kkt_solver's choice, the
+  // dense and sparse LDL' through fesd's module as IPOPT's "ma27".
+  int mode = -1;  // the module's mode, -1: not the module
+  std::string name;
   if (impl_->user_linear_solver) {
-    app.Options()->GetStringValue("linear_solver", linear_solver, "");
+    app.Options()->GetStringValue("linear_solver", name, "");
   } else {
-    const bool dense =
-        nlp.num_variables() + nlp.num_constraints() <= kDenseKktMax && load_dense_kkt();
-    linear_solver = dense ? "ma27" : "mumps";
-    app.Options()->SetStringValue("linear_solver", linear_solver);
+    const bool small = nlp.num_variables() + nlp.num_constraints() <= kDenseKktMax;
+    switch (impl_->kkt_solver) {
+      case KktSolver::Auto:
+        mode = small ? FESD_KKT_DENSE : FESD_KKT_SPARSE;
+        break;
+      case KktSolver::Dense:
+        mode = FESD_KKT_DENSE;
+        break;
+      case KktSolver::SparseLdl:
+        mode = FESD_KKT_SPARSE;
+        break;
+      case KktSolver::Mumps:
+        break;
+    }
+    if (mode >= 0 && !kkt_module().ok()) mode = -1;
+    name = mode == FESD_KKT_DENSE ? "dense" : mode == FESD_KKT_SPARSE ? "sparse_ldl" : "mumps";
   }
-  Ipopt::SmartPtr<BlockTnlp> tnlp = new BlockTnlp(nlp, start, warm);
-  const Ipopt::ApplicationReturnStatus s =
-      app.OptimizeTNLP(Ipopt::SmartPtr<Ipopt::TNLP>(Ipopt::GetRawPtr(tnlp)));
-  NlpResult r;
-  r.status = status_name(s);
-  r.linear_solver = linear_solver == "ma27" && !impl_->user_linear_solver ? "dense" : linear_solver;
-  r.success = s == Ipopt::Solve_Succeeded || s == Ipopt::Solved_To_Acceptable_Level;
-  r.eval_error = tnlp->eval_failures() > 0 && !r.success;
-  r.iterations = tnlp->iterations();
-  r.objective = tnlp->objective();
-  r.inf_pr = tnlp->inf_pr();
-  r.inf_du = tnlp->inf_du();
-  r.eval_s = tnlp->eval_s();
+  // A failed sparse solve is repeated with MUMPS from the same start: keep it.
+  const bool may_retry = mode == FESD_KKT_SPARSE;
+  const Iterate start_copy = may_retry ? start : Iterate{};
+  const auto run = [&](int run_mode) {
+    if (!impl_->user_linear_solver)
+      app.Options()->SetStringValue("linear_solver", run_mode >= 0 ? "ma27" : "mumps");
+    FesdKktStats before{};
+    if (run_mode >= 0) {
+      kkt_module().request_mode(run_mode);
+      kkt_module().stats(&before);
+    }
+    Ipopt::SmartPtr<BlockTnlp> tnlp = new BlockTnlp(nlp, start, warm);
+    const Ipopt::ApplicationReturnStatus s =
+        app.OptimizeTNLP(Ipopt::SmartPtr<Ipopt::TNLP>(Ipopt::GetRawPtr(tnlp)));
+    NlpResult r;
+    if (run_mode >= 0) {
+      FesdKktStats after{};
+      kkt_module().stats(&after);
+      kkt_module().request_mode(FESD_KKT_AUTO);
+      r.factorizations = after.factorizations - before.factorizations;
+      if (run_mode == FESD_KKT_DENSE) r.factorizations = 0;  // the dense path keeps no counters
+    }
+    const Ipopt::SmartPtr<Ipopt::IpoptData> data = app.IpoptDataObject();
+    if (Ipopt::IsValid(data))
+      r.factor_s = data->TimingStats().LinearSystemFactorization().TotalWallclockTime();
+    r.status = status_name(s);
+    r.success = s == Ipopt::Solve_Succeeded || s == Ipopt::Solved_To_Acceptable_Level;
+    r.eval_error = tnlp->eval_failures() > 0 && !r.success;
+    r.iterations = tnlp->iterations();
+    r.objective = tnlp->objective();
+    r.inf_pr = tnlp->inf_pr();
+    r.inf_du = tnlp->inf_du();
+    r.eval_s = tnlp->eval_s();
+    return std::pair{r, s};
+  };
+  auto [r, s] = run(mode);
+  r.linear_solver = name;
+  if (may_retry && !r.success && !r.eval_error && retry_with_mumps(s)) {
+    const double eval_s = r.eval_s;
+    start = start_copy;
+    r = run(-1).first;
+    r.eval_s += eval_s;
+    r.linear_solver = "mumps (sparse_ldl fallback)";
+  }
   r.total_s = seconds_since(t0);
   return r;
 }

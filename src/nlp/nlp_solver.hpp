@@ -1,5 +1,6 @@
-// src/nlp/nlp_solver.hpp: the small interface the MPCC layer solves NLPs through. IPOPT + MUMPS is
-// the one backend today; a structure-exploiting solver can replace it behind this interface.
+// src/nlp/nlp_solver.hpp: the small interface the MPCC layer solves NLPs through. IPOPT (its KKT
+// systems solved by fesd's module or MUMPS) is the one backend today; a structure-exploiting solver
+// can replace it behind this interface.
 #pragma once
 #include <memory>
 #include <string>
@@ -17,14 +18,21 @@ struct Iterate {
 };
 
 struct NlpResult {
-  bool success = false;       ///< converged (to tol or acceptable_tol)
-  bool eval_error = false;    ///< stopped because evaluations kept failing (NaN/inf)
-  std::string status;         ///< backend status name, e.g. "Solve_Succeeded"
-  std::string linear_solver;  ///< KKT solver used: "dense" (LAPACK LDL') or "mumps"
+  bool success = false;     ///< converged (to tol or acceptable_tol)
+  bool eval_error = false;  ///< stopped because evaluations kept failing (NaN/inf)
+  std::string status;       ///< backend status name, e.g. "Solve_Succeeded"
+  /// KKT solver that produced the result: "dense" (LAPACK LDL'), "sparse_ldl", "mumps", "mumps
+  /// (sparse_ldl fallback)" (sparse_ldl failed, MUMPS solved again from the same start), or
+  /// IPOPT's linear_solver when the caller set that.
+  std::string linear_solver;
   int iterations = 0;
   double objective = 0, inf_pr = 0, inf_du = 0;
   double eval_s = 0;   ///< time spent in function and derivative evaluations
   double total_s = 0;  ///< wall time of the whole solve
+  /// Wall time in IPOPT's factorizations (its LinearSystemFactorization timer), and the number of
+  /// factorizations when fesd's KKT module ran them (0 with MUMPS). Of the run reported.
+  double factor_s = 0;
+  long long factorizations = 0;
 };
 
 class NlpSolver {
@@ -38,7 +46,7 @@ class NlpSolver {
                           int max_iter) = 0;
 };
 
-/// The NLP solver every front end uses: IPOPT + MUMPS (or the dense KKT module for small NLPs).
+/// The NLP solver every front end uses: IPOPT with fesd's KKT module or MUMPS (kkt_solver).
 /// One factory, so that another backend can replace IPOPT without touching a front end. Throws
 /// fesd::InvalidOption if the backend rejects an option (the message names it).
 std::unique_ptr<NlpSolver> make_solver(const NlpOptions& options);

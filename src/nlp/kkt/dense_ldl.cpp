@@ -8,6 +8,8 @@
 // Storage: everything lives in the arrays IPOPT owns and passes back on every call, so there is no
 // global state. A = [input values (NZ) | dense factor (N*N) | scaling (N)], IW = [pivots (N) | NZ].
 // Only for small N: the required LA is NZ + N^2 + N (IPOPT multiplies it by la_init_factor).
+#include "nlp/kkt/dense_ldl.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -15,18 +17,9 @@
 extern "C" {
 void dsytrf_(const char* uplo, const int* n, double* a, const int* lda, int* ipiv, double* work,
              const int* lwork, int* info);
-
-void ma27id_(int* icntl, double* cntl);
-void ma27ad_(const int* n, const int* nz, const int* irn, const int* icn, int* iw, const int* liw,
-             int* ikeep, int* iw1, int* nsteps, int* iflag, int* icntl, double* cntl, int* info,
-             double* ops);
-void ma27bd_(const int* n, const int* nz, const int* irn, const int* icn, double* a, const int* la,
-             int* iw, const int* liw, int* ikeep, int* nsteps, int* maxfrt, int* iw1, int* icntl,
-             double* cntl, int* info);
-void ma27cd_(const int* n, double* a, const int* la, int* iw, const int* liw, double* w,
-             const int* maxfrt, double* rhs, int* iw1, const int* nsteps, int* icntl, double* cntl);
 }
 
+namespace fesd::kkt {
 namespace {
 constexpr int kInfo = 20;
 // A pivot below this fraction of the largest entry counts as zero: the matrix is reported
@@ -34,14 +27,8 @@ constexpr int kInfo = 20;
 constexpr double kSingularRel = 1e-14;
 }  // namespace
 
-void ma27id_(int* icntl, double* cntl) {
-  std::fill_n(icntl, 30, 0);
-  std::fill_n(cntl, 5, 0.0);
-  cntl[0] = 0.1;
-}
-
-void ma27ad_(const int* n, const int* nz, const int*, const int*, int*, const int*, int* ikeep,
-             int*, int* nsteps, int* iflag, int*, double*, int* info, double* ops) {
+void dense_analyse(const int* n, const int* nz, int* ikeep, int* nsteps, int* iflag, int* info,
+                   double* ops) {
   std::fill_n(info, kInfo, 0);
   std::fill_n(ikeep, 3 * (*n), 0);
   *nsteps = 1;
@@ -51,9 +38,8 @@ void ma27ad_(const int* n, const int* nz, const int*, const int*, int*, const in
   info[5] = 2 * (*n) + 1;            // NIRNEC: required LIW
 }
 
-void ma27bd_(const int* n_in, const int* nz_in, const int* irn, const int* icn, double* a,
-             const int* la, int* iw, const int* liw, int*, int*, int* maxfrt, int*, int*, double*,
-             int* info) {
+void dense_factor(const int* n_in, const int* nz_in, const int* irn, const int* icn, double* a,
+                  const int* la, int* iw, const int* liw, int* maxfrt, int* info) {
   const int n = *n_in, nz = *nz_in;
   std::fill_n(info, kInfo, 0);
   *maxfrt = 1;
@@ -196,8 +182,7 @@ void ldlt_solve(int n, const double* F, const int* ipiv, double* b) {
 }
 }  // namespace
 
-void ma27cd_(const int* n_in, double* a, const int*, int* iw, const int*, double*, const int*,
-             double* rhs, int*, const int*, int*, double*) {
+void dense_solve(const int* n_in, double* a, int* iw, double* rhs) {
   const int n = *n_in;
   // The factor sits behind the NZ input values; recover NZ from the layout IW = [pivots | NZ].
   const int nz = iw[n];
@@ -206,3 +191,5 @@ void ma27cd_(const int* n_in, double* a, const int*, int* iw, const int*, double
   ldlt_solve(n, a + nz, iw, rhs);
   for (int i = 0; i < n; ++i) rhs[i] *= scale[i];
 }
+
+}  // namespace fesd::kkt

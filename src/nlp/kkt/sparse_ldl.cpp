@@ -1,0 +1,1005 @@
+// Sparse symmetric-indefinite LDL' for IPOPT's KKT matrices, behind MA27's three steps.
+//
+// Why: above ~128 rows MUMPS took ~80 % of an IPOPT iteration on OCP (61), mostly in per-call
+// overhead and reference-BLAS kernels on small fronts (docs/kkt-solver.md).
+//
+// Method (docs/kkt-solver.md):
+//  - Ordering, once per matrix structure, on the first matrix's values: every row whose diagonal
+//    is zero (a constraint row of the KKT matrix) is matched to the neighbour with the largest
+//    entry, the pair becomes one node, and AMD (SuiteSparse) orders the compressed graph; a pair is
+//    eliminated as (its nonzero-diagonal row, then the zero-diagonal row). Plain AMD put constraint
+//    rows before their variables and delayed a pivot on almost every constraint.
+//  - Symmetric equilibration (three Ruiz sweeps, factors rounded to powers of two): inertia is
+//    kept by congruence and the pivot tests become scale-free.
+//  - Elimination tree (Liu), column counts, supernodes = chains of the tree, relaxed amalgamation
+//    (kRelax); multifrontal factorization in tree order with dense fronts. Computed once per
+//    structure and kept in IW while IPOPT keeps IW.
+//  - In a front: threshold pivoting among the fully summed rows, 1x1 if |d| >= u * column max,
+//    else a 2x2 with the largest fully summed entry of the column if |D^-1| bounds the growth by
+//    1/u; u = IPOPT's ma27_pivtol (CNTL(1)). Pivots that fail move up to the parent front
+//    (delayed pivots). Columns still failing at a root are zero to round-off: the matrix is
+//    reported singular (MA27's IFLAG = 3) and IPOPT regularizes.
+//  - Inertia: negative eigenvalues of D (1x1 by sign, 2x2 by determinant and trace), exact by
+//    Sylvester's law.
+//  - Solve: forward / diagonal / backward over the fronts, then iterative refinement on the
+//    residual of the unscaled matrix until the normwise backward error is <= kBerrTarget.
+//
+// Storage: all state is in the arrays IPOPT owns. IKEEP = [ordering (N) | unused (N) | state
+// (KeepSlot)], A = [values (NZ) | scaling (N) | per front its nf x nelim block of L with D on the
+// diagonal and a 2x2 pivot's off-diagonal at L(k+1, k)], IW = [header | pattern (2 NZ) | symbolic
+// analysis (Symbolic) | per front: nf, nelim, offset in A, nf indices, nelim pivot kinds, record
+// start]. Per-thread scratch memory (Workspace) holds no state between calls.
+#include "nlp/kkt/sparse_ldl.hpp"
+
+#include <amd.h>
+
+#include <algorithm>
+#include <bit>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+namespace fesd::kkt {
+namespace {
+
+using Index = std::int64_t;
+
+constexpr int kInfo = 20;
+constexpr int kMagic = 0x46544b4b;  // IW[0]: the factor in IW/A is ours
+constexpr int kHeader = 16;         // IW header length
+// IKEEP[2N]: whether IKEEP[0..N) holds the value-based ordering yet (MA27AD has no values).
+constexpr int kOrderingPending = 0;
+constexpr int kOrderingReady = 1;
+/// Largest number of columns merged into one supernode (a chain of the elimination tree).
+constexpr int kMaxSupernodeCols = 48;
+/// Relaxed amalgamation: a front merges into its parent's if together they have at most max_cols
+/// columns and a fraction below max_zeros of the merged front's entries are explicit zeros.
+struct Relax {
+  double max_cols, max_zeros;
+};
+constexpr Relax kRelax[] = {{8, 1.0}, {16, 0.3}, {48, 0.05}};
+/// A pivot (1x1) or a 2x2 pivot's determinant scale below this fraction of the scaled matrix's
+/// largest entry counts as zero.
+constexpr double kTinyRel = 1e-14;
+/// A diagonal below this fraction of its row's largest entry makes a row "zero-diagonal" for the
+/// ordering's matching.
+constexpr double kZeroDiagRel = 1e-10;
+/// Threshold pivoting: u = clamp(CNTL(1), kMinPivtol, kMaxPivtol).
+constexpr double kMinPivtol = 1e-8;
+constexpr double kMaxPivtol = 0.5;
+/// Iterative refinement: at most this many correction solves, stopping once the normwise backward
+/// error |b - A x| / (|A| |x| + |b|) (max-norms) is at most kBerrTarget. The componentwise error
+/// asked for a correction in most solves on OCP (61), for rows whose |A||x| + |b| is itself
+/// round-off, without changing IPOPT's iterates (IPOPT refines on the whole system anyway).
+constexpr int kMaxRefine = 3;
+constexpr double kBerrTarget = 1e-15;
+
+// IW header slots.
+enum Header {
+  kHMagic = 0,
+  kHN,
+  kHNz,
+  kHFronts,    // number of front records
+  kHFirst,     // offset of the first front record
+  kHEnd,       // end of the front records
+  kHMaxFront,  // largest front
+  kHSymbolic,  // offset of the symbolic analysis (layout: Symbolic)
+  kHEntries,   // entries of the permuted lower triangle (duplicates kept)
+  kHSupernodes
+};
+// IKEEP[2N + 1 ..]: the symbolic analysis in IW is valid for this IW (address and length), so the
+// next factorization reuses it. IPOPT keeps IW between factorizations unless it reallocates it,
+// which changes LIW.
+enum KeepSlot { kKOrdering = 0, kKSymbolic, kKLiw, kKAddrLo, kKAddrHi, kKSlots };
+
+/// The structure-only part of the factorization, computed once per structure and kept in IW:
+/// arrays of ints behind these pointers.
+struct Symbolic {
+  const int* iperm;     // n: position of each row in the elimination order
+  const int* colptr;    // n + 1: entries of the permuted lower triangle by column
+  const int* crow;      //   their rows (permuted numbering)
+  const int* slot;      // nz: where triplet e goes in crow (-1: out of range)
+  const int* cols_ptr;  // ns + 1: each supernode's columns ...
+  const int* cols;      //   ... in elimination order (permuted numbering)
+  const int* sparent;   // ns: parent supernode, -1 at a root
+  const int* cptr;      // ns + 1: each supernode's children ...
+  const int* clist;     //   ... in increasing order
+  int ns = 0;
+};
+
+Index symbolic_length(int n, int nz, int entries, int ns) {
+  return static_cast<Index>(n) * 3 + 1 + entries + nz + 3 * static_cast<Index>(ns) + 2 + ns;
+}
+
+Symbolic symbolic_view(const int* iw) {
+  const int n = iw[kHN], nz = iw[kHNz], entries = iw[kHEntries], ns = iw[kHSupernodes];
+  Symbolic v;
+  const int* q = iw + iw[kHSymbolic];
+  v.iperm = q;
+  q += n;
+  v.colptr = q;
+  q += n + 1;
+  v.crow = q;
+  q += entries;
+  v.slot = q;
+  q += nz;
+  v.cols_ptr = q;
+  q += ns + 1;
+  v.cols = q;
+  q += n;
+  v.sparent = q;
+  q += ns;
+  v.cptr = q;
+  q += ns + 1;
+  v.clist = q;
+  v.ns = ns;
+  return v;
+}
+
+bool valid(int n, int i, int j) {
+  return i >= 0 && i < n && j >= 0 && j < n;
+}
+
+/// AMD on a symmetric pattern given as column lists (either triangle; duplicates allowed).
+/// Returns false if AMD fails (then perm is the identity).
+bool amd(int n, const std::vector<int>& colptr, const std::vector<int>& rows, int* perm,
+         double* info_out = nullptr) {
+  double control[AMD_CONTROL], info[AMD_INFO];
+  amd_defaults(control);
+  const int status = amd_order(n, colptr.data(), rows.data(), perm, control, info);
+  if (info_out != nullptr) std::copy_n(info, AMD_INFO, info_out);
+  if (status < AMD_OK) {
+    for (int i = 0; i < n; ++i) perm[i] = i;
+    return false;
+  }
+  return true;
+}
+
+/// Off-diagonal triplets (0-based) grouped by column, for AMD.
+void pattern_columns(int n, int nz, const int* irn, const int* icn, const std::vector<int>& id,
+                     int ncols, std::vector<int>& colptr, std::vector<int>& rows) {
+  colptr.assign(static_cast<std::size_t>(ncols) + 1, 0);
+  for (int e = 0; e < nz; ++e) {
+    const int i = irn[e] - 1, j = icn[e] - 1;
+    if (!valid(n, i, j) || id[i] == id[j]) continue;
+    ++colptr[id[j] + 1];
+  }
+  for (int c = 0; c < ncols; ++c) colptr[c + 1] += colptr[c];
+  rows.assign(static_cast<std::size_t>(colptr[ncols]), 0);
+  std::vector<int> next(colptr.begin(), colptr.end() - 1);
+  for (int e = 0; e < nz; ++e) {
+    const int i = irn[e] - 1, j = icn[e] - 1;
+    if (!valid(n, i, j) || id[i] == id[j]) continue;
+    rows[next[id[j]]++] = id[i];
+  }
+}
+
+/// The value-based ordering (see the file comment): zero-diagonal rows matched to a neighbour,
+/// pairs compressed, AMD on the compressed graph, pairs expanded (nonzero-diagonal row first).
+void compute_ordering(int n, int nz, const int* irn, const int* icn, const double* a, int* perm) {
+  std::vector<double> diag(n, 0.0), rowmax(n, 0.0);
+  std::vector<int> deg(static_cast<std::size_t>(n) + 1, 0);
+  for (int e = 0; e < nz; ++e) {
+    const int i = irn[e] - 1, j = icn[e] - 1;
+    if (!valid(n, i, j)) continue;
+    if (i == j) {
+      diag[i] += a[e];
+    } else {
+      rowmax[i] = std::max(rowmax[i], std::abs(a[e]));
+      rowmax[j] = std::max(rowmax[j], std::abs(a[e]));
+      ++deg[i + 1];
+      ++deg[j + 1];
+    }
+  }
+  for (int i = 0; i < n; ++i) deg[i + 1] += deg[i];
+  std::vector<int> adj(static_cast<std::size_t>(deg[n]));
+  std::vector<double> weight(adj.size());
+  {
+    std::vector<int> next(deg.begin(), deg.end() - 1);
+    for (int e = 0; e < nz; ++e) {
+      const int i = irn[e] - 1, j = icn[e] - 1;
+      if (!valid(n, i, j) || i == j) continue;
+      adj[next[i]] = j;
+      weight[next[i]++] = std::abs(a[e]);
+      adj[next[j]] = i;
+      weight[next[j]++] = std::abs(a[e]);
+    }
+  }
+  std::vector<int> mate(n, -1);
+  for (int i = 0; i < n; ++i) {
+    if (mate[i] >= 0 || rowmax[i] == 0.0 || std::abs(diag[i]) > kZeroDiagRel * rowmax[i]) continue;
+    int best = -1;
+    double best_w = 0.0;
+    for (int p = deg[i]; p < deg[i + 1]; ++p)
+      if (mate[adj[p]] < 0 && weight[p] > best_w) {
+        best = adj[p];
+        best_w = weight[p];
+      }
+    if (best >= 0) {
+      mate[i] = best;
+      mate[best] = i;
+    }
+  }
+  // Compressed node c: first[c] is eliminated before second[c] (-1: a single row).
+  std::vector<int> id(n), first, second;
+  for (int i = 0; i < n; ++i) {
+    if (mate[i] >= 0 && mate[i] < i) {
+      id[i] = id[mate[i]];
+      continue;
+    }
+    id[i] = static_cast<int>(first.size());
+    if (mate[i] < 0) {
+      first.push_back(i);
+      second.push_back(-1);
+    } else {
+      // The zero-diagonal row goes second: the partner's pivot gives it a nonzero diagonal.
+      const bool i_zero = std::abs(diag[i]) <= kZeroDiagRel * rowmax[i];
+      first.push_back(i_zero ? mate[i] : i);
+      second.push_back(i_zero ? i : mate[i]);
+    }
+  }
+  const int nc = static_cast<int>(first.size());
+  std::vector<int> colptr, rows, cperm(nc);
+  pattern_columns(n, nz, irn, icn, id, nc, colptr, rows);
+  amd(nc, colptr, rows, cperm.data());
+  int k = 0;
+  for (int c : cperm) {
+    perm[k++] = first[c];
+    if (second[c] >= 0) perm[k++] = second[c];
+  }
+}
+
+/// Dense front, column-major nf x nf, lower triangle used.
+class Front {
+ public:
+  Front(double* f, int nf) : f_(f), nf_(nf) {}
+  double& at(int i, int j) { return f_[static_cast<std::size_t>(j) * nf_ + i]; }  // i >= j
+  double sym(int i, int j) { return i >= j ? at(i, j) : at(j, i); }
+  double* col(int j) { return f_ + static_cast<std::size_t>(j) * nf_; }
+
+  /// Symmetric interchange of rows/columns a < b, including the rows of the eliminated columns.
+  void swap(int a, int b, int* idx) {
+    if (a == b) return;
+    if (a > b) std::swap(a, b);
+    for (int j = 0; j < a; ++j) std::swap(at(a, j), at(b, j));
+    std::swap(at(a, a), at(b, b));
+    for (int j = a + 1; j < b; ++j) std::swap(at(j, a), at(b, j));
+    for (int i = b + 1; i < nf_; ++i) std::swap(at(i, a), at(i, b));
+    std::swap(idx[a], idx[b]);
+  }
+
+ private:
+  double* f_;
+  int nf_;
+};
+
+struct PivotResult {
+  int nelim = 0;
+  int negative = 0;
+};
+
+/// Partial LDL' of a front whose first nfs rows are fully summed: eliminates as many of them as
+/// the threshold test allows, moving accepted pivots to the front (idx follows). On return the
+/// first nelim columns hold L (D on the diagonal, a 2x2's off-diagonal at (k+1, k)), the trailing
+/// (nf - nelim) block the Schur complement. kind[k]: 1 = 1x1, 2 = first of a 2x2, 0 = second.
+// The kernels get an AVX2/FMA variant chosen at load time (the default build targets plain
+// x86-64).
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define FESD_KKT_KERNEL __attribute__((target_clones("arch=x86-64-v3", "default")))
+#else
+#define FESD_KKT_KERNEL
+#endif
+
+FESD_KKT_KERNEL PivotResult partial_ldlt(int nf, int nfs, double* storage, int* idx, int* kind,
+                                         double u, double tiny, std::vector<double>& w1,
+                                         std::vector<double>& w2) {
+  Front F(storage, nf);
+  PivotResult res;
+  w1.resize(nf);
+  w2.resize(nf);
+  int k = 0;
+  while (k < nfs) {
+    int pivot_p = -1, pivot_q = -1;
+    for (int p = k; p < nfs && pivot_p < 0; ++p) {
+      double cmax = 0.0, qmax = 0.0;
+      int q = -1;
+      for (int i = k; i < p; ++i) {
+        const double v = std::abs(F.at(p, i));
+        cmax = std::max(cmax, v);
+        if (v > qmax) {
+          qmax = v;
+          q = i;
+        }
+      }
+      for (int i = p + 1; i < nf; ++i) {
+        const double v = std::abs(F.at(i, p));
+        cmax = std::max(cmax, v);
+        if (i < nfs && v > qmax) {
+          qmax = v;
+          q = i;
+        }
+      }
+      const double app = F.at(p, p);
+      if (std::abs(app) > tiny && std::abs(app) >= u * cmax) {
+        pivot_p = p;
+        break;
+      }
+      if (q < 0 || qmax <= tiny) continue;
+      // 2x2 candidate (p, q): column maxima outside the block, then |D^-1| [cp; cq] <= 1/u.
+      const double aqq = F.at(q, q), apq = F.sym(p, q);
+      const double det = app * aqq - apq * apq;
+      if (std::abs(det) <= tiny * std::max({std::abs(app), std::abs(aqq), std::abs(apq)})) continue;
+      double cp = 0.0, cq = 0.0;
+      for (int i = k; i < nf; ++i) {
+        if (i == p || i == q) continue;
+        cp = std::max(cp, std::abs(F.sym(i, p)));
+        cq = std::max(cq, std::abs(F.sym(i, q)));
+      }
+      const double bound = std::abs(det) / u;
+      if (std::abs(aqq) * cp + std::abs(apq) * cq <= bound &&
+          std::abs(apq) * cp + std::abs(app) * cq <= bound) {
+        pivot_p = p;
+        pivot_q = q;
+      }
+    }
+    if (pivot_p < 0) break;  // the rest is delayed to the parent front
+    if (pivot_q < 0) {
+      F.swap(k, pivot_p, idx);
+      const double d = F.at(k, k);
+      if (d < 0) ++res.negative;
+      double* wk = w1.data();
+      for (int i = k + 1; i < nf; ++i) wk[i] = F.at(i, k);
+      // Fully summed columns now; the contribution block gets one update at the end.
+      for (int j = k + 1; j < nfs; ++j) {
+        const double c = wk[j] / d;
+        double* cj = F.col(j);
+        for (int i = j; i < nf; ++i) cj[i] -= wk[i] * c;
+      }
+      double* ck = F.col(k);
+      for (int i = k + 1; i < nf; ++i) ck[i] = wk[i] / d;
+      kind[k] = 1;
+      k += 1;
+    } else {
+      F.swap(k, pivot_p, idx);
+      int q = pivot_q == k ? pivot_p : pivot_q;
+      F.swap(k + 1, q, idx);
+      const double d11 = F.at(k, k), d21 = F.at(k + 1, k), d22 = F.at(k + 1, k + 1);
+      const double det = d11 * d22 - d21 * d21;
+      if (det < 0)
+        res.negative += 1;
+      else if (d11 + d22 < 0)
+        res.negative += 2;
+      double *a1 = w1.data(), *a2 = w2.data();
+      for (int i = k + 2; i < nf; ++i) {
+        a1[i] = F.at(i, k);
+        a2[i] = F.at(i, k + 1);
+      }
+      double* c1 = F.col(k);
+      double* c2 = F.col(k + 1);
+      for (int i = k + 2; i < nf; ++i) {
+        c1[i] = (d22 * a1[i] - d21 * a2[i]) / det;
+        c2[i] = (d11 * a2[i] - d21 * a1[i]) / det;
+      }
+      for (int j = k + 2; j < nfs; ++j) {
+        const double s1 = a1[j], s2 = a2[j];
+        double* cj = F.col(j);
+        for (int i = j; i < nf; ++i) cj[i] -= c1[i] * s1 + c2[i] * s2;
+      }
+      kind[k] = 2;
+      kind[k + 1] = 0;
+      k += 2;
+    }
+  }
+  res.nelim = k;
+  // Contribution block (rows and columns >= nfs): C -= L21 (D L21') over all pivots at once,
+  // one column of C at a time (it stays in cache).
+  const int m = nf - nfs;
+  if (m > 0 && k > 0) {
+    std::vector<double>& ld = w1;  // (D L')(t, j) for column j: k values
+    ld.resize(static_cast<std::size_t>(k));
+    for (int j = nfs; j < nf; ++j) {
+      for (int t = 0; t < k;) {
+        if (kind[t] == 1) {
+          ld[t] = F.at(j, t) * F.at(t, t);
+          t += 1;
+        } else {
+          const double l1 = F.at(j, t), l2 = F.at(j, t + 1);
+          const double d11 = F.at(t, t), d21 = F.at(t + 1, t), d22 = F.at(t + 1, t + 1);
+          ld[t] = l1 * d11 + l2 * d21;
+          ld[t + 1] = l1 * d21 + l2 * d22;
+          t += 2;
+        }
+      }
+      double* cj = F.col(j);
+      for (int t = 0; t < k; ++t) {
+        const double c = ld[t];
+        if (c == 0.0) continue;
+        const double* lt = F.col(t);
+        for (int i = j; i < nf; ++i) cj[i] -= lt[i] * c;
+      }
+    }
+  }
+  return res;
+}
+
+/// Contribution block a front passes to its parent: indices (permuted numbering), the first
+/// ndelayed of them delayed pivots, and the lower triangle (column-major m x m).
+struct Contribution {
+  std::vector<int> idx;
+  std::vector<double> val;
+  int ndelayed = 0;
+};
+
+/// Scratch memory of the factorization, kept per thread between calls (it holds no state: every
+/// call overwrites what it uses). Allocating it per call cost more than the factorization of a
+/// ~3000-row KKT matrix: glibc returned the freed memory to the kernel and the next call paid
+/// page faults again.
+struct Workspace {
+  std::vector<double> rmax, cval, front, w1, w2;
+  std::vector<int> pos, fidx, kind, lp;
+  std::vector<Contribution> cb;
+  std::vector<std::vector<double>> pool;
+};
+thread_local Workspace ws;
+
+/// Applies the factor to v in place: v <- S (L D L')^-1 S v.
+FESD_KKT_KERNEL void apply_inverse(const double* a, const int* iw, double* v, double* w) {
+  const int n = iw[kHN], nz = iw[kHNz];
+  const double* scale = a + nz;
+  for (int i = 0; i < n; ++i) v[i] *= scale[i];
+  const int first = iw[kHFirst], end = iw[kHEnd];
+  // Forward: L y = v and D z = y, front by front.
+  for (int p = first; p < end;) {
+    const int nf = iw[p], ne = iw[p + 1];
+    const double* L = a + iw[p + 2];
+    const int* idx = iw + p + 3;
+    const int* kind = idx + nf;
+    for (int i = 0; i < nf; ++i) w[i] = v[idx[i]];
+    for (int k = 0; k < ne;) {
+      const double* lk = L + static_cast<std::size_t>(k) * nf;
+      if (kind[k] == 1) {
+        const double y = w[k];
+        for (int i = k + 1; i < nf; ++i) w[i] -= lk[i] * y;
+        k += 1;
+      } else {
+        const double* lk1 = lk + nf;
+        const double y0 = w[k], y1 = w[k + 1];
+        for (int i = k + 2; i < nf; ++i) w[i] -= lk[i] * y0 + lk1[i] * y1;
+        k += 2;
+      }
+    }
+    for (int k = 0; k < ne;) {
+      const double* lk = L + static_cast<std::size_t>(k) * nf;
+      if (kind[k] == 1) {
+        w[k] /= lk[k];
+        k += 1;
+      } else {
+        const double d11 = lk[k], d21 = lk[k + 1], d22 = lk[nf + k + 1];
+        const double det = d11 * d22 - d21 * d21;
+        const double y0 = w[k], y1 = w[k + 1];
+        w[k] = (d22 * y0 - d21 * y1) / det;
+        w[k + 1] = (d11 * y1 - d21 * y0) / det;
+        k += 2;
+      }
+    }
+    for (int i = 0; i < nf; ++i) v[idx[i]] = w[i];
+    p += 4 + nf + ne;
+  }
+  // Backward: L' x = z, fronts in reverse.
+  for (int p = end; p > first;) {
+    p = iw[p - 1];
+    const int nf = iw[p], ne = iw[p + 1];
+    const double* L = a + iw[p + 2];
+    const int* idx = iw + p + 3;
+    const int* kind = idx + nf;
+    for (int i = 0; i < nf; ++i) w[i] = v[idx[i]];
+    for (int k = ne - 1; k >= 0;) {
+      if (kind[k] == 1) {
+        const double* lk = L + static_cast<std::size_t>(k) * nf;
+        double s = 0.0;
+        for (int i = k + 1; i < nf; ++i) s += lk[i] * w[i];
+        w[k] -= s;
+        k -= 1;
+      } else {  // kind[k] == 0: the second column of the 2x2 pivot (k - 1, k)
+        const double* l0 = L + static_cast<std::size_t>(k - 1) * nf;
+        const double* l1 = l0 + nf;
+        double s0 = 0.0, s1 = 0.0;
+        for (int i = k + 1; i < nf; ++i) {
+          s0 += l0[i] * w[i];
+          s1 += l1[i] * w[i];
+        }
+        w[k - 1] -= s0;
+        w[k] -= s1;
+        k -= 2;
+      }
+    }
+    for (int i = 0; i < ne; ++i) v[idx[i]] = w[i];
+  }
+  for (int i = 0; i < n; ++i) v[i] *= scale[i];
+}
+
+/// 2^-floor(e / 2) for v = m 2^e (1 <= m < 2): about 1 / sqrt(v), a power of two; 1 for zero,
+/// subnormal, infinite or NaN v.
+double inverse_sqrt_pow2(double v) {
+  const auto bits = std::bit_cast<std::uint64_t>(v);
+  const int biased = static_cast<int>((bits >> 52) & 0x7ff);
+  if (biased == 0 || biased == 0x7ff) return 1.0;
+  const int e = biased - 1023;
+  const int half = e >= 0 ? e / 2 : -((1 - e) / 2);  // floor(e / 2)
+  return std::bit_cast<double>(static_cast<std::uint64_t>(1023 - half) << 52);
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
+void sparse_analyse(int n, int nz, const int* irn, const int* icn, int* ikeep, int* info,
+                    double* ops) {
+  std::fill_n(info, kInfo, 0);
+  for (int e = 0; e < nz; ++e)
+    if (!valid(n, irn[e] - 1, icn[e] - 1)) info[0] = 1;  // MA27: out-of-range entries ignored
+  std::vector<int> id(n);
+  for (int i = 0; i < n; ++i) id[i] = i;
+  std::vector<int> colptr, rows;
+  pattern_columns(n, nz, irn, icn, id, n, colptr, rows);
+  double amd_info[AMD_INFO] = {};
+  std::fill_n(ikeep, 3 * static_cast<std::size_t>(n), 0);
+  if (n > 0) amd(n, colptr, rows, ikeep, amd_info);
+  if (n > 0) ikeep[2 * n] = kOrderingPending;
+  const double lnz = n > 0 ? std::max(0.0, amd_info[AMD_LNZ]) : 0.0;
+  *ops = n > 0 ? std::max(0.0, amd_info[AMD_NMULTSUBS_LDL]) : 0.0;
+  // The relaxed supernodes store each front's pivot block square and pad chains: twice AMD's
+  // count plus a margin; a factorization that needs more reports IFLAG = -4 and IPOPT grows A.
+  const double la = nz + n + 2.0 * lnz + 20.0 * n + 1000.0;
+  const double liw = kHeader + 2.0 * nz + 4.0 * n + lnz + 1000.0;
+  const double cap = static_cast<double>(std::numeric_limits<int>::max() / 8);
+  info[4] = static_cast<int>(std::min(la, cap));   // NRLNEC
+  info[5] = static_cast<int>(std::min(liw, cap));  // NIRNEC
+}
+
+/// Builds the symbolic analysis for the ordering in ikeep and writes it to IW at iw_at (the
+/// header gets its offset and sizes). Returns the IW length it needs; writes nothing if liw is
+/// too short.
+Index build_symbolic(int n, int nz, const int* irn, const int* icn, const int* perm, int* iw,
+                     Index iw_at, Index liw) {
+  std::vector<int> iperm(n);
+  for (int k = 0; k < n; ++k) iperm[perm[k]] = k;
+  // Entries by permuted column c = min, row r = max (lower triangle of P A P'); and by row for
+  // the elimination tree.
+  std::vector<int> colptr(static_cast<std::size_t>(n) + 1, 0), rowptr(colptr);
+  for (int e = 0; e < nz; ++e) {
+    const int i = irn[e] - 1, j = icn[e] - 1;
+    if (!valid(n, i, j)) continue;
+    const int r = std::max(iperm[i], iperm[j]), c = std::min(iperm[i], iperm[j]);
+    ++colptr[c + 1];
+    if (r != c) ++rowptr[r + 1];
+  }
+  for (int k = 0; k < n; ++k) {
+    colptr[k + 1] += colptr[k];
+    rowptr[k + 1] += rowptr[k];
+  }
+  std::vector<int> crow(static_cast<std::size_t>(colptr[n])), rcol(rowptr[n]), slot(nz, -1);
+  {
+    std::vector<int> cnext(colptr.begin(), colptr.end() - 1),
+        rnext(rowptr.begin(), rowptr.end() - 1);
+    for (int e = 0; e < nz; ++e) {
+      const int i = irn[e] - 1, j = icn[e] - 1;
+      if (!valid(n, i, j)) continue;
+      const int r = std::max(iperm[i], iperm[j]), c = std::min(iperm[i], iperm[j]);
+      slot[e] = cnext[c];
+      crow[cnext[c]++] = r;
+      if (r != c) rcol[rnext[r]++] = c;
+    }
+  }
+  // Elimination tree (Liu's algorithm with path compression).
+  std::vector<int> parent(n, -1), ancestor(n, -1), nchild(n, 0);
+  for (int k = 0; k < n; ++k)
+    for (int p = rowptr[k]; p < rowptr[k + 1]; ++p)
+      for (int i = rcol[p]; i != -1 && i < k;) {
+        const int next = ancestor[i];
+        ancestor[i] = k;
+        if (next == -1) parent[i] = k;
+        i = next;
+      }
+  for (int k = 0; k < n; ++k)
+    if (parent[k] >= 0) ++nchild[parent[k]];
+
+  // Column counts of L by row subtrees (O(|L|)): the front sizes for the amalgamation.
+  std::vector<int> colcount(n, 1), mark(n, -1);
+  for (int k = 0; k < n; ++k) {
+    mark[k] = k;
+    for (int p = rowptr[k]; p < rowptr[k + 1]; ++p)
+      for (int j = rcol[p]; mark[j] != k; j = parent[j]) {
+        ++colcount[j];
+        mark[j] = k;
+      }
+  }
+  // Fundamental chains j -> j + 1 (j + 1's only child, same structure below), at most
+  // kMaxSupernodeCols columns.
+  std::vector<int> chain_start{0}, chain_of(n);
+  for (int j = 1; j < n; ++j) {
+    const bool chain = parent[j - 1] == j && nchild[j] == 1 && colcount[j - 1] == colcount[j] + 1 &&
+                       j - chain_start.back() < kMaxSupernodeCols;
+    if (!chain) chain_start.push_back(j);
+  }
+  const int nchains = static_cast<int>(chain_start.size());
+  chain_start.push_back(n);
+  for (int c = 0; c < nchains; ++c)
+    for (int j = chain_start[c]; j < chain_start[c + 1]; ++j) chain_of[j] = c;
+  // Relaxed amalgamation: a chain joins its parent's front when the explicit zeros this adds stay
+  // a small fraction of the merged front (more zeros allowed for few columns). One or two columns
+  // a front left the per-front work (assembly, index lists, the solve's gathers) dominant; merging
+  // up to 16 columns regardless of zeros doubled |L| and the flops.
+  std::vector<int> rep(nchains), ncols(nchains), below(nchains);
+  std::vector<double> true_nnz(nchains, 0.0);
+  for (int c = 0; c < nchains; ++c) {
+    rep[c] = c;
+    ncols[c] = chain_start[c + 1] - chain_start[c];
+    below[c] = colcount[chain_start[c]] - ncols[c];
+    for (int j = chain_start[c]; j < chain_start[c + 1]; ++j) true_nnz[c] += colcount[j];
+  }
+  const auto find = [&](int c) {
+    while (rep[c] != c) c = rep[c] = rep[rep[c]];
+    return c;
+  };
+  for (int c = 0; c < nchains; ++c) {
+    const int last = chain_start[c + 1] - 1;
+    if (parent[last] < 0) continue;
+    const int p = find(chain_of[parent[last]]);
+    const double k = ncols[c] + ncols[p];
+    if (k > kMaxSupernodeCols) continue;
+    const double stored = k * (k + 1) / 2 + k * below[p];
+    const double zeros = 1.0 - (true_nnz[c] + true_nnz[p]) / stored;
+    bool merge = false;
+    for (const Relax& r : kRelax) merge = merge || (k <= r.max_cols && zeros < r.max_zeros);
+    if (merge) {
+      rep[c] = p;
+      ncols[p] += ncols[c];
+      true_nnz[p] += true_nnz[c];
+    }
+  }
+  // Supernodes: the amalgamated chains, numbered by their last column (children first), each
+  // with its columns in elimination order.
+  std::vector<int> sn_id(nchains, -1);
+  int ns = 0;
+  for (int c = 0; c < nchains; ++c)
+    if (find(c) == c) sn_id[c] = ns++;
+  std::vector<int> sn_of(n), cols_ptr(static_cast<std::size_t>(ns) + 1, 0), cols(n);
+  for (int j = 0; j < n; ++j) {
+    sn_of[j] = sn_id[find(chain_of[j])];
+    ++cols_ptr[sn_of[j] + 1];
+  }
+  for (int s = 0; s < ns; ++s) cols_ptr[s + 1] += cols_ptr[s];
+  {
+    std::vector<int> next(cols_ptr.begin(), cols_ptr.end() - 1);
+    for (int j = 0; j < n; ++j) cols[next[sn_of[j]]++] = j;
+  }
+  std::vector<int> sparent(ns, -1), cptr(static_cast<std::size_t>(ns) + 1, 0), clist;
+  for (int s = 0; s < ns; ++s) {
+    const int last = cols[cols_ptr[s + 1] - 1];
+    sparent[s] = parent[last] < 0 ? -1 : sn_of[parent[last]];
+    if (sparent[s] >= 0) ++cptr[sparent[s] + 1];
+  }
+  for (int s = 0; s < ns; ++s) cptr[s + 1] += cptr[s];
+  clist.resize(static_cast<std::size_t>(cptr[ns]));
+  {
+    std::vector<int> next(cptr.begin(), cptr.end() - 1);
+    for (int s = 0; s < ns; ++s)
+      if (sparent[s] >= 0) clist[next[sparent[s]]++] = s;
+  }
+
+  const int entries = colptr[n];
+  const Index need = symbolic_length(n, nz, entries, ns);
+  if (iw_at + need > liw) return iw_at + need;
+  iw[kHSymbolic] = static_cast<int>(iw_at);
+  iw[kHEntries] = entries;
+  iw[kHSupernodes] = ns;
+  int* q = iw + iw_at;
+  for (const std::vector<int>* v :
+       {&iperm, &colptr, &crow, &slot, &cols_ptr, &cols, &sparent, &cptr, &clist})
+    q = std::copy(v->begin(), v->end(), q);
+  return iw_at + need;
+}
+
+void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int la, int* iw,
+                   int liw, int* ikeep, int* maxfrt, double pivtol, int* info,
+                   FesdKktStats* stats) {
+  const auto t0 = std::chrono::steady_clock::now();
+  std::fill_n(info, kInfo, 0);
+  const Index fixed_la = static_cast<Index>(nz) + n;
+  const Index pattern_end = kHeader + 2 * static_cast<Index>(nz);
+  if (la < fixed_la) {
+    info[0] = -4;
+    info[1] = static_cast<int>(fixed_la + 2 * static_cast<Index>(nz) + 20 * static_cast<Index>(n));
+    return;
+  }
+  if (liw < pattern_end) {
+    info[0] = -3;
+    info[1] = static_cast<int>(pattern_end + 4 * static_cast<Index>(n) + 2 * nz);
+    return;
+  }
+  *maxfrt = 1;
+  int* keep = n > 0 ? ikeep + 2 * n : nullptr;
+  const auto addr = reinterpret_cast<std::uintptr_t>(iw);
+  const int addr_lo = static_cast<int>(addr & 0x7fffffffU), addr_hi = static_cast<int>(addr >> 31);
+  const bool cached = n >= kKSlots && keep[kKOrdering] == kOrderingReady && keep[kKSymbolic] == 1 &&
+                      keep[kKLiw] == liw && keep[kKAddrLo] == addr_lo &&
+                      keep[kKAddrHi] == addr_hi && iw[kHMagic] == kMagic && iw[kHN] == n &&
+                      iw[kHNz] == nz;
+  if (!cached) {
+    if (n >= kKSlots) keep[kKSymbolic] = 0;
+    iw[kHMagic] = kMagic;
+    iw[kHN] = n;
+    iw[kHNz] = nz;
+    for (int e = 0; e < nz; ++e) {
+      const bool ok = valid(n, irn[e] - 1, icn[e] - 1);
+      iw[kHeader + e] = ok ? irn[e] - 1 : -1;
+      iw[kHeader + nz + e] = ok ? icn[e] - 1 : -1;
+    }
+  }
+  iw[kHFronts] = 0;
+  iw[kHFirst] = iw[kHEnd] = static_cast<int>(pattern_end);
+  iw[kHMaxFront] = 0;
+  if (n == 0) return;
+  if (!cached) {
+    if (keep[kKOrdering] != kOrderingReady) {
+      compute_ordering(n, nz, irn, icn, a, ikeep);
+      keep[kKOrdering] = kOrderingReady;
+    }
+    const Index end = build_symbolic(n, nz, irn, icn, ikeep, iw, pattern_end, liw);
+    if (end > liw) {
+      info[0] = -3;
+      info[1] =
+          static_cast<int>(std::min<Index>(end + end / 2, std::numeric_limits<int>::max() / 4));
+      return;
+    }
+    if (n >= kKSlots) {
+      keep[kKSymbolic] = 1;
+      keep[kKLiw] = liw;
+      keep[kKAddrLo] = addr_lo;
+      keep[kKAddrHi] = addr_hi;
+    }
+  }
+  const Symbolic sym = symbolic_view(iw);
+  const Index fixed_liw = iw[kHSymbolic] + symbolic_length(n, nz, iw[kHEntries], sym.ns);
+  iw[kHFirst] = iw[kHEnd] = static_cast<int>(fixed_liw);
+  const int* perm = ikeep;
+  const int *colptr = sym.colptr, *crow = sym.crow, *cols_ptr = sym.cols_ptr, *cols = sym.cols,
+            *sparent = sym.sparent, *cptr = sym.cptr, *clist = sym.clist;
+  const int ns = sym.ns;
+
+  // Equilibration: S A S with S = scale, three Ruiz sweeps (max-norm of the rows), each factor
+  // rounded to a power of two: the scaled matrix is exact, and no sqrt or division per row (they
+  // were a quarter of the work outside the fronts).
+  double* scale = a + nz;
+  std::fill_n(scale, n, 1.0);
+  {
+    std::vector<double>& rmax = ws.rmax;
+    rmax.resize(n);
+    for (int sweep = 0; sweep < 3; ++sweep) {
+      std::fill(rmax.begin(), rmax.end(), 0.0);
+      for (int e = 0; e < nz; ++e) {
+        const int i = irn[e] - 1, j = icn[e] - 1;
+        if (!valid(n, i, j)) continue;
+        const double v = std::abs(a[e]) * scale[i] * scale[j];
+        rmax[i] = std::max(rmax[i], v);
+        rmax[j] = std::max(rmax[j], v);
+      }
+      for (int i = 0; i < n; ++i) scale[i] *= inverse_sqrt_pow2(rmax[i]);
+    }
+  }
+
+  // Scaled values in the permuted lower triangle.
+  std::vector<double>& cval = ws.cval;
+  cval.assign(static_cast<std::size_t>(iw[kHEntries]), 0.0);
+  double amax = 0.0;
+  for (int e = 0; e < nz; ++e) {
+    if (sym.slot[e] < 0) continue;
+    const double v = a[e] * scale[irn[e] - 1] * scale[icn[e] - 1];
+    amax = std::max(amax, std::abs(v));
+    cval[sym.slot[e]] = v;
+  }
+  const double tiny = kTinyRel * std::max(amax, std::numeric_limits<double>::min());
+  const double u = std::clamp(pivtol, kMinPivtol, kMaxPivtol);
+
+  // Multifrontal factorization; children (smaller last columns) come before their parent.
+  std::vector<int>&pos = ws.pos, &fidx = ws.fidx, &kind = ws.kind;
+  pos.assign(n, -1);
+  std::vector<double>&front = ws.front, &w1 = ws.w1, &w2 = ws.w2;
+  std::vector<int>& w_pos = ws.lp;
+  std::vector<Contribution>& cb = ws.cb;
+  for (Contribution& c : cb)
+    if (c.val.capacity() > 0) ws.pool.push_back(std::move(c.val));
+  cb.assign(ns, Contribution{});
+  std::vector<std::vector<double>>& pool = ws.pool;
+  Index a_next = fixed_la, iw_next = fixed_liw;
+  int negative = 0, rank = n, maxnf = 0, nfronts = 0;
+  long long delayed = 0;
+  bool singular = false;
+  for (int s = 0; s < ns; ++s) {
+    const int* own = cols + cols_ptr[s];
+    const int nown = cols_ptr[s + 1] - cols_ptr[s];
+    fidx.clear();
+    auto add = [&](int g) {
+      if (pos[g] >= 0) return;
+      pos[g] = static_cast<int>(fidx.size());
+      fidx.push_back(g);
+    };
+    for (int t = 0; t < nown; ++t) add(own[t]);
+    for (int p = cptr[s]; p < cptr[s + 1]; ++p) {
+      const Contribution& ch = cb[clist[p]];
+      for (int t = 0; t < ch.ndelayed; ++t) add(ch.idx[t]);
+    }
+    const int nfs = static_cast<int>(fidx.size());
+    for (int t = 0; t < nown; ++t)
+      for (int p = colptr[own[t]]; p < colptr[own[t] + 1]; ++p) add(crow[p]);
+    for (int p = cptr[s]; p < cptr[s + 1]; ++p)
+      for (int g : cb[clist[p]].idx) add(g);
+    const int nf = static_cast<int>(fidx.size());
+    // Front order: own columns ascending, delayed pivots, then the other rows ascending. A child's
+    // rows other than its delayed ones are ascending too, so they land in ascending positions:
+    // the extend-add below needs no per-entry triangle test for them.
+    std::sort(fidx.begin() + nfs, fidx.end());
+    for (int i = nfs; i < nf; ++i) pos[fidx[i]] = i;
+    maxnf = std::max(maxnf, nf);
+    front.assign(static_cast<std::size_t>(nf) * nf, 0.0);
+    double* fr = front.data();
+    for (int t = 0; t < nown; ++t) {
+      const int c = own[t];
+      double* fc = fr + static_cast<std::size_t>(pos[c]) * nf;
+      for (int p = colptr[c]; p < colptr[c + 1]; ++p) fc[pos[crow[p]]] += cval[p];
+    }
+    for (int p = cptr[s]; p < cptr[s + 1]; ++p) {
+      Contribution& ch = cb[clist[p]];
+      const int m = static_cast<int>(ch.idx.size());
+      std::vector<int>& lp = w_pos;
+      lp.resize(m);
+      for (int b = 0; b < m; ++b) lp[b] = pos[ch.idx[b]];
+      for (int jb = 0; jb < m; ++jb) {
+        const int pj = lp[jb];
+        const double* col = ch.val.data() + static_cast<std::size_t>(jb) * m;
+        if (jb < ch.ndelayed) {
+          for (int ib = jb; ib < m; ++ib) {
+            const int pi = lp[ib];
+            const auto at = pi >= pj ? static_cast<std::size_t>(pj) * nf + pi
+                                     : static_cast<std::size_t>(pi) * nf + pj;
+            fr[at] += col[ib];
+          }
+        } else {
+          double* fc = fr + static_cast<std::size_t>(pj) * nf;
+          for (int ib = jb; ib < m; ++ib) fc[lp[ib]] += col[ib];
+        }
+      }
+      pool.push_back(std::move(ch.val));
+      ch = Contribution{};
+    }
+    kind.assign(nf, 0);
+    const PivotResult pr =
+        partial_ldlt(nf, nfs, front.data(), fidx.data(), kind.data(), u, tiny, w1, w2);
+    const int ne = pr.nelim;
+    negative += pr.negative;
+    // Record for the solve: L block in A, indices (original numbering) and pivot kinds in IW.
+    const Index a_need = static_cast<Index>(nf) * ne, iw_need = 4 + nf + ne;
+    if (a_next + a_need <= la && iw_next + iw_need <= liw) {
+      std::copy_n(front.data(), a_need, a + a_next);
+      int* rec = iw + iw_next;
+      rec[0] = nf;
+      rec[1] = ne;
+      rec[2] = static_cast<int>(a_next);
+      for (int i = 0; i < nf; ++i) rec[3 + i] = perm[fidx[i]];
+      std::copy_n(kind.data(), ne, rec + 3 + nf);
+      rec[3 + nf + ne] = static_cast<int>(iw_next);
+    }
+    a_next += a_need;
+    iw_next += iw_need;
+    ++nfronts;
+    const int m = nf - ne;
+    delayed += nfs - ne;
+    if (m > 0) {
+      if (sparent[s] < 0) {
+        // Only delayed pivots remain at a root: zero to round-off.
+        singular = true;
+        rank -= m;
+      } else {
+        Contribution& out = cb[s];
+        out.idx.assign(fidx.begin() + ne, fidx.end());
+        out.ndelayed = nfs - ne;
+        if (!pool.empty()) {
+          out.val = std::move(pool.back());
+          pool.pop_back();
+        }
+        out.val.resize(static_cast<std::size_t>(m) * m);
+        for (int j = 0; j < m; ++j)
+          std::copy_n(front.data() + static_cast<std::size_t>(ne + j) * nf + ne, m,
+                      out.val.data() + static_cast<std::size_t>(j) * m);
+      }
+    }
+    for (int g : fidx) pos[g] = -1;
+  }
+  if (stats != nullptr) {
+    stats->delayed_pivots += delayed;
+    stats->last_n = n;
+    stats->last_factor_entries = a_next - fixed_la;
+  }
+  if (a_next > la || iw_next > liw) {
+    info[0] = a_next > la ? -4 : -3;
+    info[1] = static_cast<int>(
+        std::min<Index>(a_next > la ? a_next : iw_next, std::numeric_limits<int>::max() / 4));
+    return;
+  }
+  iw[kHFronts] = nfronts;
+  iw[kHEnd] = static_cast<int>(iw_next);
+  iw[kHMaxFront] = maxnf;
+  *maxfrt = maxnf + 4 * n;  // MA27CD's W: front vector plus refinement vectors
+  info[14] = negative;
+  if (singular) {
+    info[0] = 3;
+    info[1] = rank;
+  }
+  if (stats != nullptr) {
+    ++stats->factorizations;
+    stats->factor_seconds += seconds_since(t0);
+  }
+}
+
+void sparse_solve(int n, const double* a, const int* iw, double* w, double* rhs,
+                  FesdKktStats* stats) {
+  if (n == 0 || iw[kHMagic] != kMagic || iw[kHN] != n) return;
+  const auto t0 = std::chrono::steady_clock::now();
+  const int nz = iw[kHNz];
+  const int* irn = iw + kHeader;
+  const int* icn = irn + nz;
+  double* b = w;          // right-hand side
+  double* r = b + n;      // residual, then correction
+  double* bound = r + n;  // row sums of |A|
+  double* best = bound + n;
+  double* work = best + n;  // one front
+  std::copy_n(rhs, n, b);
+  apply_inverse(a, iw, rhs, work);
+  double best_berr = std::numeric_limits<double>::infinity();
+  for (int it = 0;; ++it) {
+    std::copy_n(b, n, r);
+    std::fill_n(bound, n, 0.0);  // row sums of |A|
+    for (int e = 0; e < nz; ++e) {
+      const int i = irn[e], j = icn[e];
+      if (i < 0) continue;
+      r[i] -= a[e] * rhs[j];
+      bound[i] += std::abs(a[e]);
+      if (i != j) {
+        r[j] -= a[e] * rhs[i];
+        bound[j] += std::abs(a[e]);
+      }
+    }
+    double rnorm = 0.0, anorm = 0.0, xnorm = 0.0, bnorm = 0.0;
+    for (int i = 0; i < n; ++i) {
+      rnorm = std::max(rnorm, std::abs(r[i]));
+      anorm = std::max(anorm, bound[i]);
+      xnorm = std::max(xnorm, std::abs(rhs[i]));
+      bnorm = std::max(bnorm, std::abs(b[i]));
+    }
+    const double scale_of = anorm * xnorm + bnorm;
+    const double berr = rnorm == 0.0   ? 0.0
+                        : scale_of > 0 ? rnorm / scale_of
+                                       : std::numeric_limits<double>::infinity();
+    if (berr >= best_berr) {  // no progress: keep the best solution
+      std::copy_n(best, n, rhs);
+      break;
+    }
+    best_berr = berr;
+    if (berr <= kBerrTarget || it == kMaxRefine) break;
+    std::copy_n(rhs, n, best);
+    apply_inverse(a, iw, r, work);
+    for (int i = 0; i < n; ++i) rhs[i] += r[i];
+    if (stats != nullptr) ++stats->refinement_steps;
+  }
+  if (stats != nullptr) {
+    ++stats->solves;
+    stats->solve_seconds += seconds_since(t0);
+  }
+}
+
+}  // namespace fesd::kkt
