@@ -343,7 +343,7 @@ class Integrator {
           {h0, std::max(sp.mpcc.lower(h0), h0_min), std::min(sp.mpcc.upper(h0), 4 * h0_min)});
     const int n_pins = static_cast<int>(pins.size());
     const mpcc::HomotopyResult again =
-        sp.mpcc.solve_again(*solver_, options_.homotopy, bounds, n_pins);
+        sp.mpcc.solve_again(solver(), options_.homotopy, bounds, n_pins);
     account(again, rows);
     if (again.status == Status::Success) {
       ++res_.summary.active_set_solves;
@@ -478,7 +478,7 @@ class Integrator {
 
   mpcc::HomotopyResult homotopy(StepProblem& sp, const HomotopyOptions& hopt,
                                 std::vector<HomotopyRow>& rows) {
-    mpcc::HomotopyResult hr = sp.mpcc.solve_homotopy(*solver_, hopt, {}, mpcc::kStepWarmMaxIter);
+    mpcc::HomotopyResult hr = sp.mpcc.solve_homotopy(solver(), hopt, {}, mpcc::kStepWarmMaxIter);
     account(hr, rows);
     return hr;
   }
@@ -542,6 +542,22 @@ class Integrator {
   const Eigen::VectorXd u_, p_;
   std::vector<std::array<Level, 2>> levels_;
   std::unique_ptr<nlp::NlpSolver> solver_;
+  std::unique_ptr<nlp::NlpSolver> mumps_;  // the retries' solver with kkt_solver = auto
+
+  /// The NLP solver of the current attempt: once an attempt of the step has failed (careful_),
+  /// and kkt_solver is auto, its retries factor the KKT systems with MUMPS, the fallback of the
+  /// sparse LDL' (docs/kkt-solver.md): on degenerate steps (co-dimension-2 sliding of the
+  /// periodic stick-slip) the two can take different paths, and a retry on the other one is the
+  /// better second try.
+  nlp::NlpSolver& solver() {
+    if (!careful_ || options_.nlp.kkt_solver != KktSolver::Auto) return *solver_;
+    if (!mumps_) {
+      NlpOptions o = options_.nlp;
+      o.kkt_solver = KktSolver::Mumps;
+      mumps_ = nlp::make_solver(o);
+    }
+    return *mumps_;
+  }
   IntegratorResult res_;
   double t_ = 0.0;
   Eigen::VectorXd x_;                    // state at t_
