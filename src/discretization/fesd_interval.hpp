@@ -192,6 +192,9 @@ class FesdInterval {
   /// interval start, or up to the next switch or the interval end) has h_n at a bound (within
   /// kHeldTol h0; at the same bound, or some collapsed and the others at the upper bound).
   std::vector<int> held_switches(const double* w) const;
+  /// The times of held_switches(w), the interval starting at t0 (for the warnings of the OCP and
+  /// the integrator).
+  std::vector<double> held_switch_times(const double* w, double t0) const;
   static constexpr double kHeldTol = 1e-6;
   /// Re-places the element boundaries of the interval for the switches of w_old: every segment
   /// (segment_boundaries()) keeps its length and gets a number of elements in proportion to it

@@ -56,6 +56,16 @@ std::vector<int> FesdInterval::held_switches(const double* w) const {
   return held;
 }
 
+std::vector<double> FesdInterval::held_switch_times(const double* w, double t0) const {
+  std::vector<double> times;
+  for (int n : held_switches(w)) {
+    double t = t0;
+    for (int e = 0; e < n; ++e) t += w[h(e)];
+    times.push_back(t);
+  }
+  return times;
+}
+
 namespace {
 
 /// Lagrange interpolation through (tau_k, y_k) at tau, component i.

@@ -367,10 +367,7 @@ class Integrator {
   /// a neighbouring segment has every element length at a bound (1 +- gamma_h) h, so the switch
   /// may have been stopped short of its time. Counted and named in a warning, never silent.
   void report_held_switches(const StepProblem& sp, double t_step) {
-    const std::vector<double>& w = sp.mpcc.solution();
-    for (int n : sp.iv->held_switches(w.data())) {
-      double t = t_step;
-      for (int e = 0; e < n; ++e) t += w[sp.iv->h(e)];
+    for (double t : sp.iv->held_switch_times(sp.mpcc.solution().data(), t_step)) {
       ++res_.summary.held_switches;
       res_.summary.warnings.push_back(fmt::format(
           "the switch at t = {:.6g} is held by the grid: the element lengths next to it are at "

@@ -540,9 +540,7 @@ void probe_touches(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Eigen::
 void report_held_switches(const OcpNlp& b, const std::vector<double>& w, Summary& summary) {
   double t0 = 0;
   for (const auto& iv : b.iv) {
-    for (int n : iv->held_switches(w.data())) {
-      double t = t0;
-      for (int e = 0; e < n; ++e) t += w[iv->h(e)];
+    for (double t : iv->held_switch_times(w.data(), t0)) {
       ++summary.held_switches;
       summary.warnings.push_back(fmt::format(
           "the switch at t = {:.6g} is held by the grid: the element lengths next to it are at "
