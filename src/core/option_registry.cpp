@@ -293,6 +293,10 @@ std::vector<Option> build() {
   o.push_back(scalar<&T::homotopy, &H::intermediate_tol>(
       kHom, "intermediate_tol", kBoth, "IPOPT tol of the NLPs with sigma > 10 complementarity_tol",
       "", Range{.min = 0, .note = "(0: ipopt.tol everywhere)"}));
+  o.push_back(scalar<&T::homotopy, &H::active_set_sigma>(
+      kHom, "active_set_sigma", Use::Ocp,
+      "end the homotopy with the active set fixed once it is stable at sigma <= this", "",
+      Range{.min = 0, .note = "(0: off)"}));
   o.push_back(scalar<&T::homotopy, &H::fix_active_set>(
       kHom, "fix_active_set", Use::Simulation,
       "solve each step's last NLP once more with its active set fixed (exact complementarity)",

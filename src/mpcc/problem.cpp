@@ -60,6 +60,15 @@ double comp_residual(const double* x, const std::vector<CompPair>& pairs) {
   return r;
 }
 
+void append(HomotopyResult& to, const HomotopyResult& from) {
+  to.rows.insert(to.rows.end(), from.rows.begin(), from.rows.end());
+  to.eval_s += from.eval_s;
+  to.solver_s += from.solver_s;
+  to.nlp_iterations += from.nlp_iterations;
+  to.comp_residual = from.comp_residual;
+  to.last_nlp_status = from.last_nlp_status;
+}
+
 void add_to_summary(const HomotopyResult& h, Summary& summary, std::vector<HomotopyRow>& rows) {
   rows.insert(rows.end(), h.rows.begin(), h.rows.end());
   summary.homotopy_steps += static_cast<int>(h.rows.size());
@@ -124,7 +133,8 @@ void Problem::copy_inputs_from(const Problem& other) {
 // ---- solving ----------------------------------------------------------------------------------
 
 HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOptions& o,
-                                       const HomotopyCallback& on_row, int warm_max_iter) {
+                                       const HomotopyCallback& on_row, int warm_max_iter,
+                                       const std::function<bool(HomotopyResult&)>& finish) {
   if (!finalized()) throw InternalError("mpcc::Problem::solve_homotopy(): not finalized");
   HomotopyResult res;
   it_ = nlp::Iterate{};
@@ -145,7 +155,7 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
         solver.solve(nlp_, it_, /*warm_start=*/k > 0, loose ? o.intermediate_tol : 0.0,
                      k > 0 ? warm_max_iter : 0);
     res.comp_residual = comp_residual(it_.x.data(), residual_pairs_);
-    record(res, r, k, sigma);
+    record(res, r, static_cast<int>(res.rows.size()), sigma);
     if (on_row) on_row(res.rows.back());
     sigma_ = sigma;
     last_ok = r.success;
@@ -158,6 +168,13 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
       continue;
     }
     if (sigma <= o.sigma_N) break;  // sigma cannot get smaller: another NLP would repeat this one
+    if (last_ok && finish) {
+      next_row_ = static_cast<int>(res.rows.size());
+      if (finish(res)) {
+        res.status = Status::Success;
+        return res;
+      }
+    }
     sigma = std::max(o.homotopy_update_slope * sigma, o.sigma_N);
   }
   next_row_ = static_cast<int>(res.rows.size());

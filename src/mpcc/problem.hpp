@@ -15,6 +15,7 @@
 // product theta_{n,m,i} * lambda_{n,m',i} over all pairs of (28), standard pairs included, i.e.
 // max over the residual pairs of |a * b|. It depends neither on cross_comp_mode nor on mpcc_mode.
 #pragma once
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -44,6 +45,10 @@ struct HomotopyResult {
   /// Set by the caller when the result is that of a re-solve with the active set fixed.
   bool active_set_fixed = false;
 };
+
+/// Appends the rows and work of `from` (a re-solve) to `to`; the residual and last status become
+/// those of `from`.
+void append(HomotopyResult& to, const HomotopyResult& from);
 
 /// Adds a homotopy's (or re-solve's) rows to `rows` and its work (NLPs, iterations, evaluation
 /// and solver time) to `summary`: the bookkeeping of every front end.
@@ -112,8 +117,13 @@ class Problem {
   /// intermediate_tol. `on_row` (if set) is called after each NLP.
   /// `warm_max_iter` > 0: at most that many IPOPT iterations in each NLP after the first (never
   /// more than the configured max_iter).
+  /// `finish` (if set) is called after each converged NLP that does not end the homotopy
+  /// anyway, with the result so far; it may solve once more (solve_again(), its rows appended to
+  /// the result) and return true to end the homotopy there with status Success (the OCP's
+  /// early switch to the fixed active set, HomotopyOptions::active_set_sigma).
   HomotopyResult solve_homotopy(nlp::NlpSolver& solver, const HomotopyOptions& options,
-                                const HomotopyCallback& on_row = {}, int warm_max_iter = 0);
+                                const HomotopyCallback& on_row = {}, int warm_max_iter = 0,
+                                const std::function<bool(HomotopyResult&)>& finish = {});
   /// Solves the last NLP of the last homotopy once more (its sigma, the configured tolerance, at
   /// most kSolveAgainMaxIter iterations, warm start) with the bounds of some variables changed,
   /// e.g. sliding exits pinned, then restores the bounds. The point is moved into the new bounds

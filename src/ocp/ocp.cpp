@@ -445,6 +445,48 @@ int fix_active_sets(const OcpNlp& b, const std::vector<double>& w, bool pin, boo
   return n_pins;
 }
 
+/// The early end of the homotopy (HomotopyOptions::active_set_sigma) as a finish hook of
+/// solve_homotopy(): after an NLP with sigma <= active_set_sigma whose active sets (every element
+/// of every interval) equal those of the NLP before, solve once more with them fixed and the
+/// sliding exits pinned; a converged solve ends the homotopy (`finished` set), a failed one lets
+/// it go on from where it was.
+std::function<bool(mpcc::HomotopyResult&)> early_active_set_finish(OcpNlp& b, const OcpOptions& o,
+                                                                   nlp::NlpSolver& solver,
+                                                                   Summary& summary,
+                                                                   bool& finished) {
+  if (!(o.homotopy.active_set_sigma > 0) || !b.iv.front()->can_pin_exits()) return {};
+  using ActiveSets = std::vector<std::vector<std::vector<int>>>;  // interval, element, regions
+  struct Seen {
+    ActiveSets before, failed;
+  };
+  auto seen = std::make_shared<Seen>();
+  return [&b, &o, &solver, &summary, &finished, seen](mpcc::HomotopyResult& h) {
+    mpcc::Problem& mp = b.mpcc;
+    ActiveSets now;
+    for (const auto& iv : b.iv) now.push_back(iv->active_sets(mp.solution().data()));
+    const bool stable = now == seen->before;
+    seen->before = now;
+    // Active sets whose fixed NLP failed are not tried again.
+    if (!stable || now == seen->failed || !(h.rows.back().sigma <= o.homotopy.active_set_sigma))
+      return false;
+    std::vector<nlp::Bound> bounds;
+    const int n_pins = fix_active_sets(b, mp.solution(), o.discretization.pin_sliding_exits,
+                                       /*every_interval=*/true, bounds);
+    const mpcc::HomotopyResult again = mp.solve_again(solver, o.homotopy, bounds, n_pins);
+    if (o.on_homotopy_row) o.on_homotopy_row(again.rows.back());
+    mpcc::append(h, again);
+    if (again.status != Status::Success) {
+      ++summary.active_set_failures;
+      seen->failed = std::move(now);
+      return false;
+    }
+    ++summary.active_set_solves;
+    summary.pinned_exits = n_pins;
+    finished = true;
+    return true;
+  };
+}
+
 /// Solves the last NLP once more from `start` with `bounds` (active sets fixed). The result is
 /// kept if it converges and keep(its cost) holds; else the point before is restored.
 template <class Account, class Keep>
@@ -626,11 +668,14 @@ OcpResult solve(const Ocp& ocp, const OcpOptions& options) {
   auto account = [&](const mpcc::HomotopyResult& h) {
     mpcc::add_to_summary(h, res.summary, res.homotopy);
   };
-  mpcc::HomotopyResult hr = mp.solve_homotopy(*solver, options.homotopy, options.on_homotopy_row);
+  bool finished_early = false;
+  const auto finish = early_active_set_finish(*b, options, *solver, res.summary, finished_early);
+  mpcc::HomotopyResult hr = mp.solve_homotopy(*solver, options.homotopy, options.on_homotopy_row,
+                                              /*warm_max_iter=*/0, finish);
   account(hr);
   // Sliding exits left early (docs/formulation.md): pin them and solve the last NLP once more;
-  // if that fails, the unpinned solution stays.
-  if (hr.status == Status::Success && options.discretization.pin_sliding_exits &&
+  // if that fails, the unpinned solution stays. (Pinned already if the homotopy ended early.)
+  if (hr.status == Status::Success && !finished_early && options.discretization.pin_sliding_exits &&
       b->iv.front()->can_pin_exits()) {
     // Per control interval: at their boundaries the control jumps, and with it the sliding
     // vector field, so a mode may end there with theta > 0; one that ends inside the last

@@ -60,6 +60,7 @@ TEST(SlidingModeOcp, NosnocExampleReachesNosnocPyObjective) {
   fesd::OcpProblem q = fesd::load_ocp_problem(std::string(FESD_SOURCE_DIR) +
                                               "/examples/ocp_sliding_mode_nosnoc.toml");
   q.options.discretization.pin_sliding_exits = false;
+  q.options.homotopy.active_set_sigma = 0;  // every NLP of nosnoc_py's homotopy
   const fesd::OcpResult r = fesd::solve(q.ocp, q.options);
   ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
   ASSERT_FALSE(r.homotopy.empty());
@@ -69,6 +70,32 @@ TEST(SlidingModeOcp, NosnocExampleReachesNosnocPyObjective) {
   EXPECT_NEAR(r.x_final()[0], -std::numbers::pi / 6, 1e-9);
   EXPECT_NEAR(r.x_final()[1], -std::numbers::pi / 4, 1e-9);
   EXPECT_EQ(r.switches.size(), 4u);
+}
+
+// REAL SOLVES (about 3 s): HomotopyOptions::active_set_sigma (default 1e-4) ends the homotopy of
+// nosnoc_py's example once the active sets are the same after two NLPs at sigma <= 1e-4, with one
+// NLP whose active sets are fixed and sliding exits pinned: the cost and switch times of the full
+// homotopy (measured 1.1e-10 and 3e-10 apart), exact complementarity, fewer NLPs (7 against 11).
+TEST(SlidingModeOcp, StableActiveSetEndsTheHomotopyEarly) {
+  fesd::OcpProblem q = fesd::load_ocp_problem(std::string(FESD_SOURCE_DIR) +
+                                              "/examples/ocp_sliding_mode_nosnoc.toml");
+  ASSERT_EQ(q.options.homotopy.active_set_sigma, 1e-4);
+  const fesd::OcpResult early = fesd::solve(q.ocp, q.options);
+  q.options.homotopy.active_set_sigma = 0;
+  const fesd::OcpResult full = fesd::solve(q.ocp, q.options);
+  ASSERT_EQ(early.status, fesd::Status::Success) << early.message;
+  ASSERT_EQ(full.status, fesd::Status::Success) << full.message;
+  EXPECT_NEAR(early.objective, full.objective, 1e-8);
+  ASSERT_EQ(early.switches.size(), full.switches.size());
+  for (std::size_t i = 0; i < early.switches.size(); ++i)
+    EXPECT_NEAR(early.switches[i].t, full.switches[i].t, 1e-8) << "switch " << i;
+  ASSERT_FALSE(early.homotopy.empty());
+  EXPECT_TRUE(early.homotopy.back().active_set_fixed);
+  EXPECT_GT(early.homotopy.back().sigma, 1e-8);  // the full homotopy goes down to 1e-9
+  EXPECT_EQ(early.comp_residual, 0.0);           // theta = 0 or lambda = 0 exactly
+  EXPECT_EQ(early.summary.pinned_exits, 2);
+  EXPECT_LT(early.homotopy.size() + 3, full.homotopy.size());
+  EXPECT_LT(early.summary.nlp_iterations, full.summary.nlp_iterations);
 }
 
 }  // namespace
