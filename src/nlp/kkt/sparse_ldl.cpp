@@ -362,7 +362,23 @@ FESD_KKT_KERNEL void update_contribution(int nf, int nfs, int k, double* f, cons
   for (; j0 + 4 <= nf; j0 += 4) contribution_block<4>(ld, k, j0, f, w + (j0 - nfs), m);
   for (; j0 < nf; ++j0) contribution_block<1>(ld, k, j0, f, w + (j0 - nfs), m);
 }
-#pragma GCC diagnostic pop
+
+/// y(i) -= x(i) c for i = from .. ld, four at a time from `from` rounded down to a multiple of 4
+/// (ld is one): the entries before `from` are a front column's unused upper triangle (any finite
+/// x there is harmless).
+FESD_KKT_INLINE void axpy_down(double* y, const double* x, double c, int from, int ld) {
+  for (int i = from & ~3; i < ld; i += 4) store4(y + i, load4(y + i) - load4(x + i) * c);
+}
+
+/// sum_i x(i) y(i) over i = from .. to with four partial sums (vectorized; reassociated).
+FESD_KKT_INLINE double dot(const double* x, const double* y, int from, int to) {
+  Vec4 acc = {};
+  int i = from;
+  for (; i + 4 <= to; i += 4) acc += load4(x + i) * load4(y + i);
+  double s = (acc[0] + acc[1]) + (acc[2] + acc[3]);
+  for (; i < to; ++i) s += x[i] * y[i];
+  return s;
+}
 
 struct PivotResult {
   int nelim = 0;
@@ -378,9 +394,10 @@ FESD_KKT_KERNEL PivotResult partial_ldlt(int nf, int nfs, double* storage, int* 
                                          double u, double tiny, std::vector<double>& w1,
                                          std::vector<double>& w2) {
   Front F(storage, nf);
+  const int ld = front_ld(nf);
   PivotResult res;
-  w1.resize(nf);
-  w2.resize(nf);
+  w1.resize(ld);
+  w2.resize(ld);
   int k = 0;
   while (k < nfs) {
     int pivot_p = -1, pivot_q = -1;
@@ -432,13 +449,11 @@ FESD_KKT_KERNEL PivotResult partial_ldlt(int nf, int nfs, double* storage, int* 
       const double d = F.at(k, k);
       if (d < 0) ++res.negative;
       double* wk = w1.data();
-      for (int i = k + 1; i < nf; ++i) wk[i] = F.at(i, k);
+      // Rows (k + 1) & ~3 .. k of wk keep what they held: axpy_down adds them only to the unused
+      // upper triangle.
+      for (int i = k + 1; i < ld; ++i) wk[i] = F.at(i, k);  // padding rows: zero
       // Fully summed columns now; the contribution block gets one update at the end.
-      for (int j = k + 1; j < nfs; ++j) {
-        const double c = wk[j] / d;
-        double* cj = F.col(j);
-        for (int i = j; i < nf; ++i) cj[i] -= wk[i] * c;
-      }
+      for (int j = k + 1; j < nfs; ++j) axpy_down(F.col(j), wk, wk[j] / d, j, ld);
       double* ck = F.col(k);
       for (int i = k + 1; i < nf; ++i) ck[i] = wk[i] / d;
       kind[k] = 1;
@@ -454,7 +469,7 @@ FESD_KKT_KERNEL PivotResult partial_ldlt(int nf, int nfs, double* storage, int* 
       else if (d11 + d22 < 0)
         res.negative += 2;
       double *a1 = w1.data(), *a2 = w2.data();
-      for (int i = k + 2; i < nf; ++i) {
+      for (int i = k + 2; i < ld; ++i) {
         a1[i] = F.at(i, k);
         a2[i] = F.at(i, k + 1);
       }
@@ -465,9 +480,12 @@ FESD_KKT_KERNEL PivotResult partial_ldlt(int nf, int nfs, double* storage, int* 
         c2[i] = (d11 * a2[i] - d21 * a1[i]) / det;
       }
       for (int j = k + 2; j < nfs; ++j) {
+        // Rows from j rounded down: the upper triangle of column j (c1, c2 hold D and the
+        // unused upper triangle there; padding rows are zero).
         const double s1 = a1[j], s2 = a2[j];
         double* cj = F.col(j);
-        for (int i = j; i < nf; ++i) cj[i] -= c1[i] * s1 + c2[i] * s2;
+        for (int i = j & ~3; i < ld; i += 4)
+          store4(cj + i, load4(cj + i) - (load4(c1 + i) * s1 + load4(c2 + i) * s2));
       }
       kind[k] = 2;
       kind[k + 1] = 0;
@@ -517,18 +535,31 @@ FESD_KKT_KERNEL void apply_inverse(const double* a, const int* iw, double* v, do
     const int* idx = iw + p + 3;
     const int* kind = idx + nf;
     for (int i = 0; i < nf; ++i) w[i] = v[idx[i]];
+    // The pivot block (triangular), then the rows below it, four columns at a time.
     for (int k = 0; k < ne;) {
       const double* lk = L + static_cast<std::size_t>(k) * nf;
       if (kind[k] == 1) {
         const double y = w[k];
-        for (int i = k + 1; i < nf; ++i) w[i] -= lk[i] * y;
+        for (int i = k + 1; i < ne; ++i) w[i] -= lk[i] * y;
         k += 1;
       } else {
         const double* lk1 = lk + nf;
         const double y0 = w[k], y1 = w[k + 1];
-        for (int i = k + 2; i < nf; ++i) w[i] -= lk[i] * y0 + lk1[i] * y1;
+        for (int i = k + 2; i < ne; ++i) w[i] -= lk[i] * y0 + lk1[i] * y1;
         k += 2;
       }
+    }
+    int c = 0;
+    for (; c + 4 <= ne; c += 4) {
+      const double* l0 = L + static_cast<std::size_t>(c) * nf;
+      const double *l1 = l0 + nf, *l2 = l1 + nf, *l3 = l2 + nf;
+      const double y0 = w[c], y1 = w[c + 1], y2 = w[c + 2], y3 = w[c + 3];
+      for (int i = ne; i < nf; ++i) w[i] -= (l0[i] * y0 + l1[i] * y1) + (l2[i] * y2 + l3[i] * y3);
+    }
+    for (; c < ne; ++c) {
+      const double* lc = L + static_cast<std::size_t>(c) * nf;
+      const double y = w[c];
+      for (int i = ne; i < nf; ++i) w[i] -= lc[i] * y;
     }
     for (int k = 0; k < ne;) {
       const double* lk = L + static_cast<std::size_t>(k) * nf;
@@ -555,18 +586,20 @@ FESD_KKT_KERNEL void apply_inverse(const double* a, const int* iw, double* v, do
     const int* idx = iw + p + 3;
     const int* kind = idx + nf;
     for (int i = 0; i < nf; ++i) w[i] = v[idx[i]];
+    // The rows below the pivot block (dot products), then the pivot block (triangular).
+    for (int k = 0; k < ne; ++k) w[k] -= dot(L + static_cast<std::size_t>(k) * nf, w, ne, nf);
     for (int k = ne - 1; k >= 0;) {
       if (kind[k] == 1) {
         const double* lk = L + static_cast<std::size_t>(k) * nf;
         double s = 0.0;
-        for (int i = k + 1; i < nf; ++i) s += lk[i] * w[i];
+        for (int i = k + 1; i < ne; ++i) s += lk[i] * w[i];
         w[k] -= s;
         k -= 1;
       } else {  // kind[k] == 0: the second column of the 2x2 pivot (k - 1, k)
         const double* l0 = L + static_cast<std::size_t>(k - 1) * nf;
         const double* l1 = l0 + nf;
         double s0 = 0.0, s1 = 0.0;
-        for (int i = k + 1; i < nf; ++i) {
+        for (int i = k + 1; i < ne; ++i) {
           s0 += l0[i] * w[i];
           s1 += l1[i] * w[i];
         }
@@ -579,6 +612,7 @@ FESD_KKT_KERNEL void apply_inverse(const double* a, const int* iw, double* v, do
   }
   for (int i = 0; i < n; ++i) v[i] *= scale[i];
 }
+#pragma GCC diagnostic pop
 
 /// 2^-floor(e / 2) for v = m 2^e (1 <= m < 2): about 1 / sqrt(v), a power of two; 1 for zero,
 /// subnormal, infinite or NaN v.
@@ -841,11 +875,13 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
   {
     std::vector<double>& rmax = ws.rmax;
     rmax.resize(n);
+    // The pattern in IW: 0-based, -1 for out-of-range entries.
+    const int *prow = iw + kHeader, *pcol = prow + nz;
     for (int sweep = 0; sweep < 3; ++sweep) {
       std::fill(rmax.begin(), rmax.end(), 0.0);
       for (int e = 0; e < nz; ++e) {
-        const int i = irn[e] - 1, j = icn[e] - 1;
-        if (!valid(n, i, j)) continue;
+        const int i = prow[e], j = pcol[e];
+        if (i < 0) continue;
         const double v = std::abs(a[e]) * scale[i] * scale[j];
         rmax[i] = std::max(rmax[i], v);
         rmax[j] = std::max(rmax[j], v);
@@ -1035,25 +1071,36 @@ void sparse_solve(int n, const double* a, const int* iw, double* w, double* rhs,
   std::copy_n(rhs, n, b);
   apply_inverse(a, iw, rhs, work);
   double best_berr = std::numeric_limits<double>::infinity();
-  for (int it = 0;; ++it) {
+  // r = b - A x; the first pass also sums |A| by rows (bound), which later passes reuse.
+  const auto residual = [&]<bool kBound>() {
     std::copy_n(b, n, r);
-    std::fill_n(bound, n, 0.0);  // row sums of |A|
+    if (kBound) std::fill_n(bound, n, 0.0);
     for (int e = 0; e < nz; ++e) {
       const int i = irn[e], j = icn[e];
       if (i < 0) continue;
       r[i] -= a[e] * rhs[j];
-      bound[i] += std::abs(a[e]);
+      if (kBound) bound[i] += std::abs(a[e]);
       if (i != j) {
         r[j] -= a[e] * rhs[i];
-        bound[j] += std::abs(a[e]);
+        if (kBound) bound[j] += std::abs(a[e]);
       }
     }
-    double rnorm = 0.0, anorm = 0.0, xnorm = 0.0, bnorm = 0.0;
+  };
+  double anorm = 0.0, bnorm = 0.0;
+  for (int it = 0;; ++it) {
+    if (it == 0) {
+      residual.template operator()<true>();
+      for (int i = 0; i < n; ++i) {
+        anorm = std::max(anorm, bound[i]);
+        bnorm = std::max(bnorm, std::abs(b[i]));
+      }
+    } else {
+      residual.template operator()<false>();
+    }
+    double rnorm = 0.0, xnorm = 0.0;
     for (int i = 0; i < n; ++i) {
       rnorm = std::max(rnorm, std::abs(r[i]));
-      anorm = std::max(anorm, bound[i]);
       xnorm = std::max(xnorm, std::abs(rhs[i]));
-      bnorm = std::max(bnorm, std::abs(b[i]));
     }
     const double scale_of = anorm * xnorm + bnorm;
     const double berr = rnorm == 0.0   ? 0.0
