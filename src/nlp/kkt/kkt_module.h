@@ -20,8 +20,8 @@ enum FesdKktMode {
 void fesd_kkt_request_mode(int mode);
 
 /* Cumulative counters of this thread's ma27bd_ calls that ran the sparse factorization:
- * number of calls, wall seconds in them, delayed pivots, and the last matrix's order and entries
- * of the factor. */
+ * number of calls, thread CPU seconds in them, delayed pivots, and the last matrix's order and
+ * entries of the factor. */
 struct FesdKktStats {
   long long factorizations;
   double factor_seconds;

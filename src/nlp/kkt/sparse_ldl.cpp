@@ -35,9 +35,10 @@
 
 #include <algorithm>
 #include <bit>
-#include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
+#include <ctime>
 #include <limits>
 #include <vector>
 
@@ -251,13 +252,19 @@ void compute_ordering(int n, int nz, const int* irn, const int* icn, const doubl
   }
 }
 
-/// Dense front, column-major nf x nf, lower triangle used.
+/// Rows of a front's column in storage: nf rounded up to a multiple of 4, so the vector kernels
+/// need no remainder loops (the padding rows stay zero).
+inline int front_ld(int nf) {
+  return (nf + 3) & ~3;
+}
+
+/// Dense front, column-major nf x nf with leading dimension front_ld(nf), lower triangle used.
 class Front {
  public:
-  Front(double* f, int nf) : f_(f), nf_(nf) {}
-  double& at(int i, int j) { return f_[static_cast<std::size_t>(j) * nf_ + i]; }  // i >= j
+  Front(double* f, int nf) : f_(f), nf_(nf), ld_(front_ld(nf)) {}
+  double& at(int i, int j) { return f_[static_cast<std::size_t>(j) * ld_ + i]; }  // i >= j
   double sym(int i, int j) { return i >= j ? at(i, j) : at(j, i); }
-  double* col(int j) { return f_ + static_cast<std::size_t>(j) * nf_; }
+  double* col(int j) { return f_ + static_cast<std::size_t>(j) * ld_; }
 
   /// Symmetric interchange of rows/columns a < b, including the rows of the eliminated columns.
   void swap(int a, int b, int* idx) {
@@ -272,8 +279,106 @@ class Front {
 
  private:
   double* f_;
-  int nf_;
+  int nf_, ld_;
 };
+
+// The kernels get an AVX2/FMA variant chosen at load time (the default build targets plain
+// x86-64).
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define FESD_KKT_KERNEL __attribute__((target_clones("arch=x86-64-v3", "default")))
+#define FESD_KKT_INLINE __attribute__((always_inline)) inline
+#else
+#define FESD_KKT_KERNEL
+#define FESD_KKT_INLINE inline
+#endif
+
+/// Four doubles (two SSE registers in the default clone, one AVX register in the x86-64-v3 one).
+/// Its helpers are always inlined, so GCC's note (-Wpsabi) that passing it by value changes the ABI
+/// without AVX does not apply.
+using Vec4 = double __attribute__((vector_size(32)));
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"
+FESD_KKT_INLINE Vec4 load4(const double* p) {
+  Vec4 v;
+  __builtin_memcpy(&v, p, sizeof v);
+  return v;
+}
+FESD_KKT_INLINE void store4(double* p, Vec4 v) {
+  __builtin_memcpy(p, &v, sizeof v);
+}
+
+/// C(:, j0 .. j0 + NB) -= L W for a front's contribution columns j0 .. j0 + NB: L = the front's
+/// first k columns, W = (D L') (row t at w + t ldw). Rows four at a time, from j0 rounded down to
+/// a multiple of 4 to the padded end of the column, with NB vector accumulators over all k pivots,
+/// so each entry of C is loaded and stored once (the former kernel did an axpy per pivot and
+/// column). Rows above a column's diagonal get updated too: the unused upper triangle.
+template <int NB>
+FESD_KKT_INLINE void contribution_block(int ld, int k, int j0, double* f, const double* w,
+                                        int ldw) {
+  const std::size_t lds = static_cast<std::size_t>(ld);
+  for (int i = j0 & ~3; i < ld; i += 4) {
+    Vec4 acc[NB] = {};
+    for (int t = 0; t < k; ++t) {
+      const Vec4 l = load4(f + t * lds + i);
+      const double* wt = w + static_cast<std::size_t>(t) * ldw;
+      for (int c = 0; c < NB; ++c) acc[c] += l * wt[c];
+    }
+    for (int c = 0; c < NB; ++c) {
+      double* cj = f + (j0 + c) * lds + i;
+      store4(cj, load4(cj) - acc[c]);
+    }
+  }
+}
+
+/// Schur update of a front's contribution block (rows and columns >= nfs) with its k pivots:
+/// C -= L21 D L21', as a matrix product in blocks of four columns.
+FESD_KKT_KERNEL void update_contribution(int nf, int nfs, int k, double* f, const int* kind,
+                                         std::vector<double>& wbuf) {
+  const int m = nf - nfs, ld = front_ld(nf);
+  const std::size_t lds = static_cast<std::size_t>(ld);
+  // W = D L21' (k x m, by rows): row t is pivot t's column of L below the fully summed rows
+  // times D.
+  wbuf.resize(static_cast<std::size_t>(k) * m);
+  double* w = wbuf.data();
+  for (int t = 0; t < k;) {
+    const double* lt = f + t * lds + nfs;
+    double* wt = w + static_cast<std::size_t>(t) * m;
+    if (kind[t] == 1) {
+      const double d = f[t * lds + t];
+      for (int c = 0; c < m; ++c) wt[c] = lt[c] * d;
+      t += 1;
+    } else {
+      const double* lt1 = lt + lds;
+      double* wt1 = wt + m;
+      const double d11 = f[t * lds + t], d21 = f[t * lds + t + 1], d22 = f[(t + 1) * lds + t + 1];
+      for (int c = 0; c < m; ++c) {
+        wt[c] = lt[c] * d11 + lt1[c] * d21;
+        wt1[c] = lt[c] * d21 + lt1[c] * d22;
+      }
+      t += 2;
+    }
+  }
+  int j0 = nfs;
+  for (; j0 + 4 <= nf; j0 += 4) contribution_block<4>(ld, k, j0, f, w + (j0 - nfs), m);
+  for (; j0 < nf; ++j0) contribution_block<1>(ld, k, j0, f, w + (j0 - nfs), m);
+}
+
+/// y(i) -= x(i) c for i = from .. ld, four at a time from `from` rounded down to a multiple of 4
+/// (ld is one): the entries before `from` are a front column's unused upper triangle (any finite
+/// x there is harmless).
+FESD_KKT_INLINE void axpy_down(double* y, const double* x, double c, int from, int ld) {
+  for (int i = from & ~3; i < ld; i += 4) store4(y + i, load4(y + i) - load4(x + i) * c);
+}
+
+/// sum_i x(i) y(i) over i = from .. to with four partial sums (vectorized; reassociated).
+FESD_KKT_INLINE double dot(const double* x, const double* y, int from, int to) {
+  Vec4 acc = {};
+  int i = from;
+  for (; i + 4 <= to; i += 4) acc += load4(x + i) * load4(y + i);
+  double s = (acc[0] + acc[1]) + (acc[2] + acc[3]);
+  for (; i < to; ++i) s += x[i] * y[i];
+  return s;
+}
 
 struct PivotResult {
   int nelim = 0;
@@ -284,21 +389,15 @@ struct PivotResult {
 /// the threshold test allows, moving accepted pivots to the front (idx follows). On return the
 /// first nelim columns hold L (D on the diagonal, a 2x2's off-diagonal at (k+1, k)), the trailing
 /// (nf - nelim) block the Schur complement. kind[k]: 1 = 1x1, 2 = first of a 2x2, 0 = second.
-// The kernels get an AVX2/FMA variant chosen at load time (the default build targets plain
-// x86-64).
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define FESD_KKT_KERNEL __attribute__((target_clones("arch=x86-64-v3", "default")))
-#else
-#define FESD_KKT_KERNEL
-#endif
-
+/// Only the lower triangle of the front is read or kept.
 FESD_KKT_KERNEL PivotResult partial_ldlt(int nf, int nfs, double* storage, int* idx, int* kind,
                                          double u, double tiny, std::vector<double>& w1,
                                          std::vector<double>& w2) {
   Front F(storage, nf);
+  const int ld = front_ld(nf);
   PivotResult res;
-  w1.resize(nf);
-  w2.resize(nf);
+  w1.resize(ld);
+  w2.resize(ld);
   int k = 0;
   while (k < nfs) {
     int pivot_p = -1, pivot_q = -1;
@@ -350,13 +449,11 @@ FESD_KKT_KERNEL PivotResult partial_ldlt(int nf, int nfs, double* storage, int* 
       const double d = F.at(k, k);
       if (d < 0) ++res.negative;
       double* wk = w1.data();
-      for (int i = k + 1; i < nf; ++i) wk[i] = F.at(i, k);
+      // Rows (k + 1) & ~3 .. k of wk keep what they held: axpy_down adds them only to the unused
+      // upper triangle.
+      for (int i = k + 1; i < ld; ++i) wk[i] = F.at(i, k);  // padding rows: zero
       // Fully summed columns now; the contribution block gets one update at the end.
-      for (int j = k + 1; j < nfs; ++j) {
-        const double c = wk[j] / d;
-        double* cj = F.col(j);
-        for (int i = j; i < nf; ++i) cj[i] -= wk[i] * c;
-      }
+      for (int j = k + 1; j < nfs; ++j) axpy_down(F.col(j), wk, wk[j] / d, j, ld);
       double* ck = F.col(k);
       for (int i = k + 1; i < nf; ++i) ck[i] = wk[i] / d;
       kind[k] = 1;
@@ -372,7 +469,7 @@ FESD_KKT_KERNEL PivotResult partial_ldlt(int nf, int nfs, double* storage, int* 
       else if (d11 + d22 < 0)
         res.negative += 2;
       double *a1 = w1.data(), *a2 = w2.data();
-      for (int i = k + 2; i < nf; ++i) {
+      for (int i = k + 2; i < ld; ++i) {
         a1[i] = F.at(i, k);
         a2[i] = F.at(i, k + 1);
       }
@@ -383,9 +480,12 @@ FESD_KKT_KERNEL PivotResult partial_ldlt(int nf, int nfs, double* storage, int* 
         c2[i] = (d11 * a2[i] - d21 * a1[i]) / det;
       }
       for (int j = k + 2; j < nfs; ++j) {
+        // Rows from j rounded down: the upper triangle of column j (c1, c2 hold D and the
+        // unused upper triangle there; padding rows are zero).
         const double s1 = a1[j], s2 = a2[j];
         double* cj = F.col(j);
-        for (int i = j; i < nf; ++i) cj[i] -= c1[i] * s1 + c2[i] * s2;
+        for (int i = j & ~3; i < ld; i += 4)
+          store4(cj + i, load4(cj + i) - (load4(c1 + i) * s1 + load4(c2 + i) * s2));
       }
       kind[k] = 2;
       kind[k + 1] = 0;
@@ -393,34 +493,7 @@ FESD_KKT_KERNEL PivotResult partial_ldlt(int nf, int nfs, double* storage, int* 
     }
   }
   res.nelim = k;
-  // Contribution block (rows and columns >= nfs): C -= L21 (D L21') over all pivots at once,
-  // one column of C at a time (it stays in cache).
-  const int m = nf - nfs;
-  if (m > 0 && k > 0) {
-    std::vector<double>& ld = w1;  // (D L')(t, j) for column j: k values
-    ld.resize(static_cast<std::size_t>(k));
-    for (int j = nfs; j < nf; ++j) {
-      for (int t = 0; t < k;) {
-        if (kind[t] == 1) {
-          ld[t] = F.at(j, t) * F.at(t, t);
-          t += 1;
-        } else {
-          const double l1 = F.at(j, t), l2 = F.at(j, t + 1);
-          const double d11 = F.at(t, t), d21 = F.at(t + 1, t), d22 = F.at(t + 1, t + 1);
-          ld[t] = l1 * d11 + l2 * d21;
-          ld[t + 1] = l1 * d21 + l2 * d22;
-          t += 2;
-        }
-      }
-      double* cj = F.col(j);
-      for (int t = 0; t < k; ++t) {
-        const double c = ld[t];
-        if (c == 0.0) continue;
-        const double* lt = F.col(t);
-        for (int i = j; i < nf; ++i) cj[i] -= lt[i] * c;
-      }
-    }
-  }
+  if (nf > nfs && k > 0) update_contribution(nf, nfs, k, storage, kind, w1);
   return res;
 }
 
@@ -442,7 +515,12 @@ struct Workspace {
   std::vector<Contribution> cb;
   std::vector<std::vector<double>> pool;
 };
-thread_local Workspace ws;
+/// The thread's workspace, behind a call: with the thread_local used directly, GCC re-derived its
+/// address (__tls_get_addr) inside the front loop, ~34000 calls per factorization on OCP (61).
+[[gnu::noinline]] Workspace& thread_workspace() {
+  thread_local Workspace ws;
+  return ws;
+}
 
 /// Applies the factor to v in place: v <- S (L D L')^-1 S v.
 FESD_KKT_KERNEL void apply_inverse(const double* a, const int* iw, double* v, double* w) {
@@ -457,18 +535,31 @@ FESD_KKT_KERNEL void apply_inverse(const double* a, const int* iw, double* v, do
     const int* idx = iw + p + 3;
     const int* kind = idx + nf;
     for (int i = 0; i < nf; ++i) w[i] = v[idx[i]];
+    // The pivot block (triangular), then the rows below it, four columns at a time.
     for (int k = 0; k < ne;) {
       const double* lk = L + static_cast<std::size_t>(k) * nf;
       if (kind[k] == 1) {
         const double y = w[k];
-        for (int i = k + 1; i < nf; ++i) w[i] -= lk[i] * y;
+        for (int i = k + 1; i < ne; ++i) w[i] -= lk[i] * y;
         k += 1;
       } else {
         const double* lk1 = lk + nf;
         const double y0 = w[k], y1 = w[k + 1];
-        for (int i = k + 2; i < nf; ++i) w[i] -= lk[i] * y0 + lk1[i] * y1;
+        for (int i = k + 2; i < ne; ++i) w[i] -= lk[i] * y0 + lk1[i] * y1;
         k += 2;
       }
+    }
+    int c = 0;
+    for (; c + 4 <= ne; c += 4) {
+      const double* l0 = L + static_cast<std::size_t>(c) * nf;
+      const double *l1 = l0 + nf, *l2 = l1 + nf, *l3 = l2 + nf;
+      const double y0 = w[c], y1 = w[c + 1], y2 = w[c + 2], y3 = w[c + 3];
+      for (int i = ne; i < nf; ++i) w[i] -= (l0[i] * y0 + l1[i] * y1) + (l2[i] * y2 + l3[i] * y3);
+    }
+    for (; c < ne; ++c) {
+      const double* lc = L + static_cast<std::size_t>(c) * nf;
+      const double y = w[c];
+      for (int i = ne; i < nf; ++i) w[i] -= lc[i] * y;
     }
     for (int k = 0; k < ne;) {
       const double* lk = L + static_cast<std::size_t>(k) * nf;
@@ -495,18 +586,20 @@ FESD_KKT_KERNEL void apply_inverse(const double* a, const int* iw, double* v, do
     const int* idx = iw + p + 3;
     const int* kind = idx + nf;
     for (int i = 0; i < nf; ++i) w[i] = v[idx[i]];
+    // The rows below the pivot block (dot products), then the pivot block (triangular).
+    for (int k = 0; k < ne; ++k) w[k] -= dot(L + static_cast<std::size_t>(k) * nf, w, ne, nf);
     for (int k = ne - 1; k >= 0;) {
       if (kind[k] == 1) {
         const double* lk = L + static_cast<std::size_t>(k) * nf;
         double s = 0.0;
-        for (int i = k + 1; i < nf; ++i) s += lk[i] * w[i];
+        for (int i = k + 1; i < ne; ++i) s += lk[i] * w[i];
         w[k] -= s;
         k -= 1;
       } else {  // kind[k] == 0: the second column of the 2x2 pivot (k - 1, k)
         const double* l0 = L + static_cast<std::size_t>(k - 1) * nf;
         const double* l1 = l0 + nf;
         double s0 = 0.0, s1 = 0.0;
-        for (int i = k + 1; i < nf; ++i) {
+        for (int i = k + 1; i < ne; ++i) {
           s0 += l0[i] * w[i];
           s1 += l1[i] * w[i];
         }
@@ -519,6 +612,7 @@ FESD_KKT_KERNEL void apply_inverse(const double* a, const int* iw, double* v, do
   }
   for (int i = 0; i < n; ++i) v[i] *= scale[i];
 }
+#pragma GCC diagnostic pop
 
 /// 2^-floor(e / 2) for v = m 2^e (1 <= m < 2): about 1 / sqrt(v), a power of two; 1 for zero,
 /// subnormal, infinite or NaN v.
@@ -531,8 +625,12 @@ double inverse_sqrt_pow2(double v) {
   return std::bit_cast<double>(static_cast<std::uint64_t>(1023 - half) << 52);
 }
 
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+/// The calling thread's CPU time in seconds (the statistics' clock: on a shared machine wall time
+/// counted other processes' time slices).
+double thread_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
 }  // namespace
@@ -708,7 +806,7 @@ Index build_symbolic(int n, int nz, const int* irn, const int* icn, const int* p
 void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int la, int* iw,
                    int liw, int* ikeep, int* maxfrt, double pivtol, int* info,
                    FesdKktStats* stats) {
-  const auto t0 = std::chrono::steady_clock::now();
+  const double t0 = thread_seconds();
   std::fill_n(info, kInfo, 0);
   const Index fixed_la = static_cast<Index>(nz) + n;
   const Index pattern_end = kHeader + 2 * static_cast<Index>(nz);
@@ -777,14 +875,17 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
   // were a quarter of the work outside the fronts).
   double* scale = a + nz;
   std::fill_n(scale, n, 1.0);
+  Workspace& ws = thread_workspace();
   {
     std::vector<double>& rmax = ws.rmax;
     rmax.resize(n);
+    // The pattern in IW: 0-based, -1 for out-of-range entries.
+    const int *prow = iw + kHeader, *pcol = prow + nz;
     for (int sweep = 0; sweep < 3; ++sweep) {
       std::fill(rmax.begin(), rmax.end(), 0.0);
       for (int e = 0; e < nz; ++e) {
-        const int i = irn[e] - 1, j = icn[e] - 1;
-        if (!valid(n, i, j)) continue;
+        const int i = prow[e], j = pcol[e];
+        if (i < 0) continue;
         const double v = std::abs(a[e]) * scale[i] * scale[j];
         rmax[i] = std::max(rmax[i], v);
         rmax[j] = std::max(rmax[j], v);
@@ -812,10 +913,17 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
   std::vector<double>&front = ws.front, &w1 = ws.w1, &w2 = ws.w2;
   std::vector<int>& w_pos = ws.lp;
   std::vector<Contribution>& cb = ws.cb;
-  for (Contribution& c : cb)
-    if (c.val.capacity() > 0) ws.pool.push_back(std::move(c.val));
-  cb.assign(ns, Contribution{});
   std::vector<std::vector<double>>& pool = ws.pool;
+  // Contribution records are reused (their index lists keep their capacity: allocating them per
+  // front was 130000 new / delete per run of OCP (61)); value blocks go back to the pool.
+  if (cb.size() < static_cast<std::size_t>(ns)) cb.resize(ns);
+  const auto release = [&pool](Contribution& c) {
+    if (c.val.capacity() > 0) pool.push_back(std::move(c.val));
+    c.val.clear();
+    c.idx.clear();
+    c.ndelayed = 0;
+  };
+  for (int s = 0; s < ns; ++s) release(cb[s]);
   Index a_next = fixed_la, iw_next = fixed_liw;
   int negative = 0, rank = n, maxnf = 0, nfronts = 0;
   long long delayed = 0;
@@ -846,11 +954,16 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
     std::sort(fidx.begin() + nfs, fidx.end());
     for (int i = nfs; i < nf; ++i) pos[fidx[i]] = i;
     maxnf = std::max(maxnf, nf);
-    front.assign(static_cast<std::size_t>(nf) * nf, 0.0);
+    const int ld = front_ld(nf);
+    if (front.size() < static_cast<std::size_t>(ld) * nf)
+      front.resize(static_cast<std::size_t>(ld) * nf);
     double* fr = front.data();
+    // One memset of the whole front: zeroing only the lower triangle took a memset call per
+    // column (GCC turns the loop into one), more than the stores for these short columns.
+    std::memset(fr, 0, sizeof(double) * static_cast<std::size_t>(ld) * nf);
     for (int t = 0; t < nown; ++t) {
       const int c = own[t];
-      double* fc = fr + static_cast<std::size_t>(pos[c]) * nf;
+      double* fc = fr + static_cast<std::size_t>(pos[c]) * ld;
       for (int p = colptr[c]; p < colptr[c + 1]; ++p) fc[pos[crow[p]]] += cval[p];
     }
     for (int p = cptr[s]; p < cptr[s + 1]; ++p) {
@@ -865,17 +978,16 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
         if (jb < ch.ndelayed) {
           for (int ib = jb; ib < m; ++ib) {
             const int pi = lp[ib];
-            const auto at = pi >= pj ? static_cast<std::size_t>(pj) * nf + pi
-                                     : static_cast<std::size_t>(pi) * nf + pj;
+            const auto at = pi >= pj ? static_cast<std::size_t>(pj) * ld + pi
+                                     : static_cast<std::size_t>(pi) * ld + pj;
             fr[at] += col[ib];
           }
         } else {
-          double* fc = fr + static_cast<std::size_t>(pj) * nf;
+          double* fc = fr + static_cast<std::size_t>(pj) * ld;
           for (int ib = jb; ib < m; ++ib) fc[lp[ib]] += col[ib];
         }
       }
-      pool.push_back(std::move(ch.val));
-      ch = Contribution{};
+      release(ch);
     }
     kind.assign(nf, 0);
     const PivotResult pr =
@@ -885,7 +997,9 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
     // Record for the solve: L block in A, indices (original numbering) and pivot kinds in IW.
     const Index a_need = static_cast<Index>(nf) * ne, iw_need = 4 + nf + ne;
     if (a_next + a_need <= la && iw_next + iw_need <= liw) {
-      std::copy_n(front.data(), a_need, a + a_next);
+      for (int j = 0; j < ne; ++j)
+        std::copy_n(fr + static_cast<std::size_t>(j) * ld, nf,
+                    a + a_next + static_cast<Index>(j) * nf);
       int* rec = iw + iw_next;
       rec[0] = nf;
       rec[1] = ne;
@@ -913,9 +1027,9 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
           pool.pop_back();
         }
         out.val.resize(static_cast<std::size_t>(m) * m);
-        for (int j = 0; j < m; ++j)
-          std::copy_n(front.data() + static_cast<std::size_t>(ne + j) * nf + ne, m,
-                      out.val.data() + static_cast<std::size_t>(j) * m);
+        for (int j = 0; j < m; ++j)  // lower triangle
+          std::copy_n(fr + static_cast<std::size_t>(ne + j) * ld + ne + j, m - j,
+                      out.val.data() + static_cast<std::size_t>(j) * m + j);
       }
     }
     for (int g : fidx) pos[g] = -1;
@@ -942,14 +1056,14 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
   }
   if (stats != nullptr) {
     ++stats->factorizations;
-    stats->factor_seconds += seconds_since(t0);
+    stats->factor_seconds += thread_seconds() - t0;
   }
 }
 
 void sparse_solve(int n, const double* a, const int* iw, double* w, double* rhs,
                   FesdKktStats* stats) {
   if (n == 0 || iw[kHMagic] != kMagic || iw[kHN] != n) return;
-  const auto t0 = std::chrono::steady_clock::now();
+  const double t0 = thread_seconds();
   const int nz = iw[kHNz];
   const int* irn = iw + kHeader;
   const int* icn = irn + nz;
@@ -961,25 +1075,36 @@ void sparse_solve(int n, const double* a, const int* iw, double* w, double* rhs,
   std::copy_n(rhs, n, b);
   apply_inverse(a, iw, rhs, work);
   double best_berr = std::numeric_limits<double>::infinity();
-  for (int it = 0;; ++it) {
+  // r = b - A x; the first pass also sums |A| by rows (bound), which later passes reuse.
+  const auto residual = [&]<bool kBound>() {
     std::copy_n(b, n, r);
-    std::fill_n(bound, n, 0.0);  // row sums of |A|
+    if (kBound) std::fill_n(bound, n, 0.0);
     for (int e = 0; e < nz; ++e) {
       const int i = irn[e], j = icn[e];
       if (i < 0) continue;
       r[i] -= a[e] * rhs[j];
-      bound[i] += std::abs(a[e]);
+      if (kBound) bound[i] += std::abs(a[e]);
       if (i != j) {
         r[j] -= a[e] * rhs[i];
-        bound[j] += std::abs(a[e]);
+        if (kBound) bound[j] += std::abs(a[e]);
       }
     }
-    double rnorm = 0.0, anorm = 0.0, xnorm = 0.0, bnorm = 0.0;
+  };
+  double anorm = 0.0, bnorm = 0.0;
+  for (int it = 0;; ++it) {
+    if (it == 0) {
+      residual.template operator()<true>();
+      for (int i = 0; i < n; ++i) {
+        anorm = std::max(anorm, bound[i]);
+        bnorm = std::max(bnorm, std::abs(b[i]));
+      }
+    } else {
+      residual.template operator()<false>();
+    }
+    double rnorm = 0.0, xnorm = 0.0;
     for (int i = 0; i < n; ++i) {
       rnorm = std::max(rnorm, std::abs(r[i]));
-      anorm = std::max(anorm, bound[i]);
       xnorm = std::max(xnorm, std::abs(rhs[i]));
-      bnorm = std::max(bnorm, std::abs(b[i]));
     }
     const double scale_of = anorm * xnorm + bnorm;
     const double berr = rnorm == 0.0   ? 0.0
@@ -998,7 +1123,7 @@ void sparse_solve(int n, const double* a, const int* iw, double* w, double* rhs,
   }
   if (stats != nullptr) {
     ++stats->solves;
-    stats->solve_seconds += seconds_since(t0);
+    stats->solve_seconds += thread_seconds() - t0;
   }
 }
 
