@@ -98,6 +98,10 @@ struct Summary {
   /// Re-solves from a probe of a touch (a switch born where the solution touched a switching
   /// surface) that were kept: they converged and lowered the cost.
   int born_switches = 0;
+  /// Re-solves of the allocation search (the OCP moved one element from a segment between two
+  /// switches to its neighbour), and those of them that were kept (they lowered the cost).
+  int allocation_solves = 0;
+  int allocation_moves = 0;
   /// Switches still held by an h_n bound in the result (each also named in `warnings`).
   int held_switches = 0;
   /// What the user should know about the result although it succeeded (settings that cannot

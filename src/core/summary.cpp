@@ -77,6 +77,10 @@ std::string format_work(const Summary& s, double per_step) {
   if (s.grid_moves > 0 || s.held_switches > 0)
     out += fmt::format("  grid moves           {}  ({} switch{} still held by an h bound)\n",
                        s.grid_moves, s.held_switches, s.held_switches == 1 ? "" : "es");
+  if (s.allocation_solves > 0)
+    out +=
+        fmt::format("  allocation moves     {}  ({} re-solve{} of the allocation search)\n",
+                    s.allocation_moves, s.allocation_solves, s.allocation_solves == 1 ? "" : "s");
   if (s.born_switches > 0)
     out += fmt::format("  born switches        {}  (probed at a touch of a switching surface)\n",
                        s.born_switches);

@@ -205,6 +205,15 @@ class FesdInterval {
   /// w_new (the rest stays). False (w_new unchanged) if it cannot: more segments than elements,
   /// or a segment whose uniform h would leave the bounds of h.
   bool regrid(const double* w_old, std::vector<double>& w_new) const;
+  /// The number of elements of each segment of w (the differences of segment_boundaries()).
+  std::vector<int> segment_counts(const double* w) const;
+  /// As regrid(w_old, w_new), with `count[j]` elements in segment j (count.size() must equal
+  /// the number of segments, each >= 1, summing to N_FE): an allocation of the elements to the
+  /// segments (the OCP's allocation search). Where a segment's length over its count leaves the
+  /// bounds of h, every segment's h becomes clamp(length / count + nu) with one nu that keeps
+  /// the interval's length: the switches move, and the states of each segment extend its old
+  /// polynomials. False (w_new unchanged) if count does not fit the segments.
+  bool regrid(const double* w_old, std::vector<double>& w_new, const std::vector<int>& count) const;
   /// A touch: at boundary n (0..N_FE-1, the start of element n, of positive length; collapsed
   /// elements before it are skipped) the state lies on the boundary of
   /// region r (lambda_r at that point <= kTouchTol) while r is active neither in element n nor

@@ -98,23 +98,70 @@ std::vector<int> apportion(const std::vector<double>& lengths, int N) {
 
 }  // namespace
 
+std::vector<int> FesdInterval::segment_counts(const double* w) const {
+  const std::vector<int> b = segment_boundaries(w);
+  std::vector<int> count(b.size() - 1);
+  for (std::size_t j = 0; j + 1 < b.size(); ++j) count[j] = b[j + 1] - b[j];
+  return count;
+}
+
 bool FesdInterval::regrid(const double* w_old, std::vector<double>& w_new) const {
+  const std::vector<int> b = segment_boundaries(w_old);
+  const std::size_t J = b.size() - 1;  // segments
+  if (static_cast<int>(J) > N_FE_) return false;
+  std::vector<double> lengths(J);
+  for (std::size_t j = 0; j < J; ++j)
+    for (int n = b[j]; n < b[j + 1]; ++n) lengths[j] += w_old[h(n)];
+  const std::vector<int> count = apportion(lengths, N_FE_);
+  const double h0 = in_.T / N_FE_;
+  for (std::size_t j = 0; j < J; ++j) {  // the switches stay where they are
+    const double hj = lengths[j] / count[j];
+    if (hj < (1.0 - opt_.gamma_h) * h0 - held_tol() || hj > (1.0 + opt_.gamma_h) * h0 + held_tol())
+      return false;
+  }
+  return regrid(w_old, w_new, count);
+}
+
+bool FesdInterval::regrid(const double* w_old, std::vector<double>& w_new,
+                          const std::vector<int>& count) const {
   if (!opt_.use_fesd) return false;
   const int n_x = model_.n_x(), n_th = model_.n_theta(), n_sys = model_.n_sys();
   const double h0 = in_.T / N_FE_;
   const double lb = (1.0 - opt_.gamma_h) * h0, ub = (1.0 + opt_.gamma_h) * h0;
   const std::vector<int> b = segment_boundaries(w_old);
   const std::size_t J = b.size() - 1;  // segments
-  if (static_cast<int>(J) > N_FE_) return false;
+  if (count.size() != J || std::accumulate(count.begin(), count.end(), 0) != N_FE_ ||
+      *std::min_element(count.begin(), count.end()) < 1)
+    return false;
   std::vector<double> t_old(N_FE_ + 1, 0.0);  // old element boundaries
   for (int n = 0; n < N_FE_; ++n) t_old[n + 1] = t_old[n] + w_old[h(n)];
-  std::vector<double> lengths(J);
-  for (std::size_t j = 0; j < J; ++j) lengths[j] = t_old[b[j + 1]] - t_old[b[j]];
-  const std::vector<int> count = apportion(lengths, N_FE_);
-  for (std::size_t j = 0; j < J; ++j) {
-    const double hj = lengths[j] / count[j];
-    if (hj < lb - held_tol() || hj > ub + held_tol()) return false;
+  // The new h of each segment: its length over its count, unless that leaves the bounds of h;
+  // then clamp(length / count + nu, lb, ub) with nu such that the interval keeps its length (the
+  // switches move; the states of a segment extend its polynomials).
+  std::vector<double> h_seg(J);
+  auto place = [&](double nu, bool clamp) {
+    double total = 0;
+    for (std::size_t j = 0; j < J; ++j) {
+      const double hj = (t_old[b[j + 1]] - t_old[b[j]]) / count[j] + nu;
+      h_seg[j] = clamp ? std::clamp(hj, lb, ub) : hj;
+      total += count[j] * h_seg[j];
+    }
+    return total;
+  };
+  place(0.0, false);
+  if (std::any_of(h_seg.begin(), h_seg.end(),
+                  [&](double hj) { return hj < lb - held_tol() || hj > ub + held_tol(); })) {
+    const double T = t_old[N_FE_];
+    double lo = -T, hi = T;  // place(lo) <= T <= place(hi)
+    for (int it = 0; it < 200 && hi - lo > 1e-15 * h0; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      (place(mid, true) < T ? lo : hi) = mid;
+    }
+    place(0.5 * (lo + hi), true);
   }
+  std::vector<double> t_seg(J + 1, 0.0);  // new segment boundaries
+  for (std::size_t j = 0; j < J; ++j) t_seg[j + 1] = t_seg[j] + count[j] * h_seg[j];
+  t_seg[J] = t_old[N_FE_];
 
   // Interpolation nodes of an old element: its start, the stage points strictly inside, its end.
   std::vector<double> tau{0.0};
@@ -142,7 +189,7 @@ bool FesdInterval::regrid(const double* w_old, std::vector<double>& w_new) const
   int e = 0;
   double t = 0;
   for (std::size_t j = 0; j < J; ++j) {
-    const double hj = lengths[j] / count[j];
+    const double hj = h_seg[j];
     for (int k = 0; k < count[j]; ++k, ++e) {
       const bool last_in_segment = k + 1 == count[j];
       w_new[h(e)] = std::clamp(hj, lb, ub);
@@ -159,7 +206,7 @@ bool FesdInterval::regrid(const double* w_old, std::vector<double>& w_new) const
         }
         for (int k2 = 0; k2 < n_sys; ++k2) w_new[mu(e, s, k2)] = w_old[mu(n, s, k2)];
       }
-      const double t_end = last_in_segment ? t_old[b[j + 1]] : t + hj;
+      const double t_end = last_in_segment ? t_seg[j + 1] : t + hj;
       const int n_end = last_in_segment ? b[j + 1] - 1 : old_element(j, t_end);
       if (!stiffly_accurate_) {  // else x_{e+1} is the last stage state, set above
         for (int i = 0; i < n_x; ++i) w_new[x(e + 1, i)] = state_at(n_end, t_end, i);
@@ -170,7 +217,7 @@ bool FesdInterval::regrid(const double* w_old, std::vector<double>& w_new) const
       }
       t += hj;
     }
-    t = t_old[b[j + 1]];
+    t = t_seg[j + 1];
   }
   update_lifted_guess(w_new);
   return true;

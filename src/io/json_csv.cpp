@@ -64,6 +64,8 @@ json stats(const Summary& s) {
               {"pin_failures", s.pin_failures},
               {"grid_moves", s.grid_moves},
               {"born_switches", s.born_switches},
+              {"allocation_solves", s.allocation_solves},
+              {"allocation_moves", s.allocation_moves},
               {"held_switches", s.held_switches},
               {"warnings", s.warnings}};
 }

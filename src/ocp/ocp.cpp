@@ -8,7 +8,9 @@
 #include <cstdio>
 #include <limits>
 #include <memory>
+#include <set>
 #include <sstream>
+#include <tuple>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -22,6 +24,7 @@
 #include "nlp/block_nlp.hpp"
 #include "nlp/nlp_solver.hpp"
 #include "nlp/sum_block.hpp"
+#include "ocp/allocation.hpp"
 #include "ocp/ocp_checks.hpp"
 #include "ocp/ocp_input.hpp"
 
@@ -578,6 +581,133 @@ void probe_touches(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Eigen::
   }
 }
 
+/// One move of the allocation search: interval k's segment j - 1 gets `dir` elements more and
+/// segment j as many fewer (dir 0: the counts as they are), all of equal length on each segment
+/// (FesdInterval::regrid with explicit counts), and the last NLP is solved from there with every
+/// active set fixed. The re-gridded point is the old solution on each segment, so its cost (the
+/// new quadrature of the old trajectory) predicts the move: it is solved only if that cost is
+/// lower, or if the regrid had to move the switch (an h bound). Kept (true) if it converges and
+/// lowers the cost.
+template <class Account>
+bool try_allocation_move(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Eigen::VectorXd& p,
+                         nlp::NlpSolver& solver, const Account& account, mpcc::HomotopyResult& hr,
+                         std::size_t k, std::size_t j, int dir, Summary& summary) {
+  const FesdInterval& iv = *b.iv[k];
+  const std::vector<double> w = b.mpcc.solution();
+  std::vector<int> count = iv.segment_counts(w.data());
+  if (j >= count.size()) return false;
+  count[j - 1] += dir;
+  count[j] -= dir;
+  std::vector<double> start = w;
+  if (!iv.regrid(w.data(), start, count)) return false;
+  const double cost_before = cost(b, ocp, w, p);
+  const double slack = 1e-9 * std::max(1.0, std::abs(cost_before));
+  auto switch_time = [&](const std::vector<double>& v) {
+    double t = 0;
+    for (int n = 0; n < iv.segment_boundaries(v.data())[j]; ++n) t += v[iv.h(n)];
+    return t;
+  };
+  const bool moved = std::abs(switch_time(w) - switch_time(start)) > 1e-9 * ocp.T;
+  if (!moved && cost(b, ocp, start, p) >= cost_before - slack) return false;
+  std::vector<nlp::Bound> bounds;
+  const int n_pins = fix_active_sets(b, start, o.discretization.pin_sliding_exits,
+                                     /*every_interval=*/true, bounds);
+  ++summary.allocation_solves;
+  return try_resolve(b, ocp, o, p, solver, account, hr, start, bounds, n_pins,
+                     [&](double c) { return c < cost_before - slack; });
+}
+
+/// The allocation search (docs/formulation.md, "Switches held by the grid"): how many elements
+/// each segment between two switches gets is a discrete choice the NLP does not make, and with
+/// l2_relaxed (zero on every grid uniform between switches) the cost depends on it wherever the
+/// scheme's quadrature is not exact. A coordinate descent: for each switch of each interval,
+/// move one element from one neighbouring segment to the other and re-solve; keep the move if
+/// the cost falls and go on in that direction while it falls; repeat until no single move
+/// improves. At most 2 N_FE re-solves per switch; a move is solved only where the cost of the
+/// re-gridded point predicts a gain (try_allocation_move), so a scheme whose quadrature is exact
+/// for the problem costs none. Only with step_eq = l2_relaxed: the other penalties pull every h_n
+/// to h0 (heuristic_*) and so decide the allocation themselves, or are not the default.
+template <class Account>
+void search_allocation(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Eigen::VectorXd& p,
+                       nlp::NlpSolver& solver, const Account& account, mpcc::HomotopyResult& hr,
+                       Summary& summary) {
+  if (o.discretization.step_eq != StepEq::L2Relaxed) return;
+  int budget = 0, n_switches = 0;
+  {
+    const std::vector<double> w = b.mpcc.solution();
+    for (const auto& iv : b.iv) {
+      const int n = static_cast<int>(iv->segment_counts(w.data()).size()) - 1;
+      n_switches += n;
+      budget += 2 * iv->N_FE() * n;
+    }
+  }
+  const int solves_end = summary.allocation_solves + budget;
+  // Re-solves that did not lower the cost, by interval, kind (dir 0 or not) and allocation: not
+  // tried again in a later pass.
+  std::set<std::tuple<std::size_t, bool, std::vector<int>>> failed;
+  auto step = [&](std::size_t k, std::size_t j, int dir) {
+    if (summary.allocation_solves >= solves_end) return false;
+    std::vector<int> count = b.iv[k]->segment_counts(b.mpcc.solution().data());
+    if (j >= count.size()) return false;
+    count[j - 1] += dir;
+    count[j] -= dir;
+    auto key = std::make_tuple(k, dir == 0, std::move(count));
+    if (failed.contains(key)) return false;
+    const int solves = summary.allocation_solves;
+    if (try_allocation_move(b, ocp, o, p, solver, account, hr, k, j, dir, summary)) {
+      ++summary.allocation_moves;
+      return true;
+    }
+    if (summary.allocation_solves > solves) failed.insert(std::move(key));
+    return false;
+  };
+  // The grid uniform on each segment with the counts as they are (dir 0): the re-solve after a
+  // move can end at a grid that is not, next to a switch.
+  auto even_out = [&](std::size_t k) {
+    while (step(k, 1, 0)) {
+    }
+  };
+  bool improved = false;
+  do {
+    improved = false;
+    for (std::size_t k = 0; k < b.iv.size(); ++k) {
+      even_out(k);
+      for (std::size_t j = 1; j < b.iv[k]->segment_counts(b.mpcc.solution().data()).size(); ++j)
+        for (int dir : {1, -1})
+          while (step(k, j, dir)) {
+            improved = true;
+            even_out(k);
+          }
+    }
+  } while (improved && n_switches > 0);
+}
+
+/// The allocation `count` in every interval (ocp_detail::solve_allocation): re-grid, then solve
+/// the last NLP with every active set fixed; the result kept whatever its cost. False (the point
+/// before restored) if an interval cannot be re-gridded or the re-solve fails.
+template <class Account>
+bool force_allocation(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Eigen::VectorXd& p,
+                      nlp::NlpSolver& solver, const Account& account, mpcc::HomotopyResult& hr,
+                      const std::vector<int>& count, Summary& summary) {
+  const std::vector<double> w = b.mpcc.solution();
+  std::vector<double> start = w;
+  for (const auto& iv : b.iv)
+    if (!iv->regrid(w.data(), start, count)) return false;
+  std::vector<nlp::Bound> bounds;
+  const int n_pins = fix_active_sets(b, start, o.discretization.pin_sliding_exits,
+                                     /*every_interval=*/true, bounds);
+  if (!try_resolve(b, ocp, o, p, solver, account, hr, start, bounds, n_pins,
+                   [](double) { return true; }))
+    return false;
+  // Then uniform on each segment again while that lowers the cost (the allocation search's
+  // first step).
+  for (std::size_t k = 0; k < b.iv.size(); ++k)
+    for (int n = 0;
+         n < 8 && try_allocation_move(b, ocp, o, p, solver, account, hr, k, 1, 0, summary); ++n) {
+    }
+  return true;
+}
+
 /// Counts the switches still held by the grid and names each in a warning.
 void report_held_switches(const OcpNlp& b, const std::vector<double>& w, Summary& summary) {
   double t0 = 0;
@@ -645,7 +775,12 @@ std::vector<std::string> validate(const OcpOptions& o) {
   return validate(o.discretization, o.homotopy, o.nlp);
 }
 
-OcpResult solve(const Ocp& ocp, const OcpOptions& options) {
+namespace {
+
+/// solve() with the allocation `count` forced after the homotopy (ocp_detail::solve_allocation)
+/// when `count` is not null; `applied` tells whether it could be.
+OcpResult solve_impl(const Ocp& ocp, const OcpOptions& options, const std::vector<int>* count,
+                     bool* applied) {
   const auto t_start = Clock::now();
   ocp_detail::require_valid_input(ocp, options);  // src/ocp/ocp_input.cpp, shared with files
   const Eigen::VectorXd p = ocp.p.size() > 0 ? ocp.p : ocp.model.p_default;  // n_p checked
@@ -703,6 +838,9 @@ OcpResult solve(const Ocp& ocp, const OcpOptions& options) {
   if (hr.status == Status::Success && options.discretization.use_fesd) {
     move_held_switches(*b, ocp, options, p, *solver, account, hr, res.summary);
     probe_touches(*b, ocp, options, p, *solver, account, hr, res.summary);
+    search_allocation(*b, ocp, options, p, *solver, account, hr, res.summary);
+    if (count != nullptr)
+      *applied = force_allocation(*b, ocp, options, p, *solver, account, hr, *count, res.summary);
     report_held_switches(*b, mp.solution(), res.summary);
   }
   res.status = hr.status;
@@ -716,6 +854,20 @@ OcpResult solve(const Ocp& ocp, const OcpOptions& options) {
   if (options.initialization == OcpInitialization::Simulation && !simulated)
     res.message += " [the initializing simulation failed or used another grid: constant guess]";
   res.summary.wall_s = seconds_since(t_start);
+  return res;
+}
+
+}  // namespace
+
+OcpResult solve(const Ocp& ocp, const OcpOptions& options) {
+  return solve_impl(ocp, options, nullptr, nullptr);
+}
+
+std::optional<OcpResult> ocp_detail::solve_allocation(const Ocp& ocp, const OcpOptions& options,
+                                                      const std::vector<int>& count) {
+  bool applied = false;
+  OcpResult res = solve_impl(ocp, options, &count, &applied);
+  if (!applied) return std::nullopt;
   return res;
 }
 

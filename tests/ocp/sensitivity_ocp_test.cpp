@@ -47,7 +47,10 @@ class SensitivityFesdFixed : public ::testing::TestWithParam<double> {};
 TEST_P(SensitivityFesdFixed, ReachesTheTrueMinimizer) {
   const fesd::OcpResult r =
       fesd::solve(sensitivity_ocp(GetParam()), sensitivity_options(true, false));
-  EXPECT_EQ(r.homotopy.size(), 1u);
+  // One NLP at the fixed sigma; the allocation search may add a re-solve that it did not keep
+  // (a move whose uniform h leaves the bounds of h is solved without a prediction).
+  EXPECT_EQ(r.homotopy.size() - static_cast<std::size_t>(r.summary.allocation_solves), 1u);
+  EXPECT_EQ(r.summary.allocation_moves, 0);
   expect_optimum(r);
 }
 INSTANTIATE_TEST_SUITE_P(Guesses, SensitivityFesdFixed, ::testing::Values(-2.7, -1.9, -0.6));

@@ -1,0 +1,98 @@
+// tests/ocp/allocation_search_test.cpp: the allocation search of the OCP (issue 14, item 1;
+// docs/formulation.md, "Switches held by the grid").
+//
+// For Radau IIA n_s = 1 and Lobatto IIIC n_s = 2 the quadrature of (56)'s cost is not exact, so
+// with step equilibration l2_relaxed (zero on every grid uniform between switches) the discrete
+// cost depends on how many elements each segment gets. The OCP must reach the minimizer of the
+// discretized problem from any guess. The pinned values are those of the brute-force scan over
+// all N_FE - 1 allocations in bench/ocp_robustness ("discrete minimizer (scan over the ...
+// allocations)"), with default options otherwise.
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include <fesd/ocp.hpp>
+
+#include "../../bench/sensitivity_ocp.hpp"
+
+namespace {
+
+using fesd_bench::sensitivity_ocp;
+
+struct AllocationCase {
+  fesd::RkScheme scheme;
+  int n_s, N_FE;
+  fesd::OcpInitialization init;
+  double guess;
+  double x0, objective;  // the discrete minimizer (scan)
+};
+
+fesd::OcpOptions defaults_with(const AllocationCase& c) {
+  fesd::OcpOptions o;
+  o.discretization.rk_scheme = c.scheme;
+  o.discretization.n_s = c.n_s;
+  o.discretization.N_FE = c.N_FE;
+  o.initialization = c.init;
+  return o;
+}
+
+class AllocationSearch : public ::testing::TestWithParam<AllocationCase> {};
+
+// Tolerances: x0 1e-6 (the issue's), the objective 1e-8 (the NLPs are solved to 1e-9 and the
+// solution is a smooth minimizer for its allocation).
+TEST_P(AllocationSearch, ReachesTheDiscreteMinimizer) {
+  const AllocationCase c = GetParam();
+  const fesd::OcpResult r = fesd::solve(sensitivity_ocp(c.guess), defaults_with(c));
+  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+  EXPECT_NEAR(r.x0()[0], c.x0, 1e-6);
+  EXPECT_NEAR(r.objective, c.objective, 1e-8);
+  ASSERT_EQ(r.switches.size(), 1u);
+  EXPECT_LE(r.summary.allocation_moves, r.summary.allocation_solves);
+}
+
+// Lobatto IIIC 2, N_FE 25: 10 elements before the switch, 15 after, uniform on each (the
+// trapezoidal rule on these grids: V(x0) is a cubic whose minimum is 1.5280108158 at x0 =
+// -1.42646811, also computed in closed form). Radau IIA 1, N_FE 25: 3 elements before the switch,
+// each at the upper bound 2 h0 of h_n, so x0 = -3 * 3 * 2 * 2 / 25 = -1.44 (the switch held by
+// the bound: the discrete minimizer itself, with a warning). Radau IIA 1, N_FE 10: 2 elements.
+constexpr double kLobattoX0 = -1.4264681103779044, kLobattoV = 1.528010815766055;
+constexpr double kRadau25X0 = -1.44, kRadau25V = 1.4550706870;
+constexpr double kRadau10X0 = -1.9902452943, kRadau10V = 1.3801859262;
+
+using fesd::OcpInitialization;
+using fesd::RkScheme;
+INSTANTIATE_TEST_SUITE_P(
+    Guesses, AllocationSearch,
+    ::testing::Values(AllocationCase{RkScheme::LobattoIIIC, 2, 25, OcpInitialization::Constant,
+                                     -2.7, kLobattoX0, kLobattoV},
+                      AllocationCase{RkScheme::LobattoIIIC, 2, 25, OcpInitialization::Simulation,
+                                     -0.9, kLobattoX0, kLobattoV},
+                      AllocationCase{RkScheme::LobattoIIIC, 2, 25, OcpInitialization::Constant, 0.9,
+                                     kLobattoX0, kLobattoV},
+                      AllocationCase{RkScheme::LobattoIIIC, 2, 25, OcpInitialization::Simulation,
+                                     2.7, kLobattoX0, kLobattoV},
+                      AllocationCase{RkScheme::RadauIIA, 1, 25, OcpInitialization::Simulation, -2.7,
+                                     kRadau25X0, kRadau25V},
+                      AllocationCase{RkScheme::RadauIIA, 1, 25, OcpInitialization::Constant, -0.9,
+                                     kRadau25X0, kRadau25V},
+                      AllocationCase{RkScheme::RadauIIA, 1, 25, OcpInitialization::Simulation, 0.9,
+                                     kRadau25X0, kRadau25V},
+                      AllocationCase{RkScheme::RadauIIA, 1, 25, OcpInitialization::Constant, 2.7,
+                                     kRadau25X0, kRadau25V},
+                      AllocationCase{RkScheme::RadauIIA, 1, 10, OcpInitialization::Constant, -2.7,
+                                     kRadau10X0, kRadau10V},
+                      AllocationCase{RkScheme::RadauIIA, 1, 10, OcpInitialization::Simulation, 2.7,
+                                     kRadau10X0, kRadau10V}));
+
+// Where the quadrature is exact (Gauss-Legendre n_s = 2 on (56)) the allocation does not change
+// the cost: the re-gridded points predict no gain and the search solves nothing.
+TEST(AllocationSearchExactQuadrature, SolvesNothing) {
+  const AllocationCase c{
+      RkScheme::GaussLegendre, 2, 25, OcpInitialization::Simulation, -2.7, NAN, NAN};
+  const fesd::OcpResult r = fesd::solve(sensitivity_ocp(c.guess), defaults_with(c));
+  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+  EXPECT_NEAR(r.x0()[0], fesd_bench::kSensitivityX0Star, 1e-6);
+  EXPECT_EQ(r.summary.allocation_solves, 0);
+}
+
+}  // namespace
