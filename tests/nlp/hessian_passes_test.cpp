@@ -1,0 +1,278 @@
+// tests/nlp/hessian_passes_test.cpp: the planned Hessian passes of AutoDiffBlock (one pass per
+// input of a vertex cover of the Hessian graph, only that input's partners carried in the
+// gradient; src/nlp/block.hpp, docs/derivatives.md) against the reference plan (one pass per
+// column with every input carried: the Hessian as computed before the plan), to 1e-12 relative:
+// single blocks with C++ functors and with the problem-file OCP functions (expression bytecode),
+// and whole FESD NLPs of every step equilibration with a C++ model and with expression models.
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "discretization/fesd_interval.hpp"
+#include "fesd/model.hpp"
+#include "fesd/problem_file.hpp"
+#include "mpcc/relaxation.hpp"
+#include "nlp/block.hpp"
+#include "nlp/block_nlp.hpp"
+#include "support/compare.hpp"
+
+namespace {
+
+using fesd::nlp::BlockPattern;
+
+BlockPattern pattern_of(std::vector<std::pair<int, int>> pairs, int k) {
+  BlockPattern bp;
+  bp.hess = std::move(pairs);
+  std::sort(bp.hess.begin(), bp.hess.end());
+  fesd::nlp::plan_hessian_passes(bp, k);
+  return bp;
+}
+
+/// Every pair in exactly one pass, as the pass's column and one of its rows.
+void expect_cover(const BlockPattern& bp) {
+  std::vector<int> count(bp.hess.size(), 0);
+  int widest = 0;
+  for (const auto& pass : bp.passes) {
+    ASSERT_EQ(pass.rows.size(), pass.entry.size());
+    widest = std::max(widest, static_cast<int>(pass.rows.size()));
+    for (std::size_t l = 0; l < pass.rows.size(); ++l) {
+      const auto [i, j] = bp.hess.at(static_cast<std::size_t>(pass.entry[l]));
+      EXPECT_EQ(std::max(pass.col, pass.rows[l]), i);
+      EXPECT_EQ(std::min(pass.col, pass.rows[l]), j);
+      ++count[static_cast<std::size_t>(pass.entry[l])];
+    }
+  }
+  for (int c : count) EXPECT_EQ(c, 1);
+  EXPECT_EQ(bp.max_pass_rows, widest);
+}
+
+TEST(HessianPasses, CoverEveryPairOnceWithFewPasses) {
+  // Bilinear theta x (X, u) as in the dynamics rows V - sum_r f_r(X, u) theta_r with linear f_r:
+  // inputs 0..3 theta, 4..9 X and u. A vertex cover of K_{4,6}: the 4 theta passes.
+  std::vector<std::pair<int, int>> bilinear;
+  for (int r = 0; r < 4; ++r)
+    for (int i = 4; i < 10; ++i) bilinear.emplace_back(i, r);
+  const BlockPattern a = pattern_of(bilinear, 12);
+  expect_cover(a);
+  ASSERT_EQ(a.passes.size(), 4U);
+  for (const auto& pass : a.passes) EXPECT_LT(pass.col, 4);
+  EXPECT_EQ(a.max_pass_rows, 6);
+
+  // A diagonal entry is only computed by its own input's pass.
+  const BlockPattern b = pattern_of({{2, 2}, {2, 0}, {1, 0}, {3, 1}}, 4);
+  expect_cover(b);
+  EXPECT_EQ(b.passes.front().col, 2);
+  ASSERT_EQ(b.passes.size(), 2U);  // 2, then 1 covers (1, 0) and (3, 1)
+  EXPECT_EQ(b.passes.back().col, 1);
+
+  EXPECT_TRUE(pattern_of({}, 5).passes.empty());
+
+  // Dense: k passes at most, |hess| gradient entries in all.
+  std::vector<std::pair<int, int>> dense;
+  for (int i = 0; i < 7; ++i)
+    for (int j = 0; j <= i; ++j) dense.emplace_back(i, j);
+  const BlockPattern d = pattern_of(dense, 7);
+  expect_cover(d);
+  EXPECT_EQ(d.passes.size(), 7U);
+}
+
+std::vector<double> random_values(std::size_t n, unsigned seed, double lo, double hi) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(lo, hi);
+  std::vector<double> v(n);
+  for (double& x : v) x = u(rng);
+  return v;
+}
+
+/// Planned passes vs the reference plan of the same block at w (Hessian entries of the pattern).
+void expect_same_hessian(const fesd::nlp::Block& block, const std::vector<double>& w,
+                         unsigned seed) {
+  const BlockPattern planned = block.pattern(w.data());
+  BlockPattern reference = planned;
+  fesd::nlp::plan_column_passes(reference, block.num_inputs());
+  ASSERT_FALSE(planned.hess.empty());
+  const std::vector<double> y =
+      random_values(static_cast<std::size_t>(block.num_outputs()), seed, -1.0, 1.0);
+  std::vector<double> h(planned.hess.size(), 7.0), h_ref(planned.hess.size(), -7.0);
+  ASSERT_TRUE(block.hessian(w.data(), y.data(), planned, h.data()));
+  ASSERT_TRUE(block.hessian(w.data(), y.data(), reference, h_ref.data()));
+  double scale = 0;
+  for (double v : h_ref) scale = std::max(scale, std::abs(v));
+  EXPECT_TRUE(fesd::testing::near_arrays(h, h_ref, 1e-12 * scale, 1e-12));
+}
+
+/// Every operation of ad.hpp, nonlinear in several inputs, two outputs.
+struct Mixed {
+  int num_inputs() const { return 9; }
+  int num_outputs() const { return 2; }
+  template <class T>
+  void operator()(const T* w, T* c) const {
+    using std::atan;
+    using std::cos;
+    using std::cosh;
+    using std::exp;
+    using std::log;
+    using std::pow;
+    using std::sin;
+    using std::sinh;
+    using std::sqrt;
+    using std::tan;
+    using std::tanh;
+    c[0] = w[0] * w[1] * sin(w[2]) + exp(w[3] * w[4]) / (1.0 + w[5] * w[5]) + pow(w[6], 2.5) -
+           log(w[7]) * sqrt(w[8]) + 3.0 * w[0];
+    c[1] = tanh(w[1] - w[2]) * cos(w[3]) + pow(w[4], w[5]) + atan(w[6] * w[0]) +
+           sinh(w[7]) * cosh(w[8]) + tan(0.3 * w[2]) - 2.0 / w[5];
+  }
+};
+
+/// The step equilibration product (31) of two elements with lifted sums: the densest block.
+struct EtaProduct {
+  int n_theta = 4;
+  int num_inputs() const { return 2 + 4 * n_theta; }
+  int num_outputs() const { return 1; }
+  template <class T>
+  void operator()(const T* w, T* c) const {
+    T e(1.0);
+    for (int r = 0; r < n_theta; ++r) {
+      const T* s = w + 2 + 4 * r;
+      e = e * (s[0] * s[1] + s[2] * s[3]);
+    }
+    c[0] = (w[1] - w[0]) * e;
+  }
+};
+
+TEST(HessianPasses, AutoDiffBlocksMatchTheColumnPasses) {
+  const auto mixed = fesd::nlp::make_block(Mixed{});
+  expect_same_hessian(*mixed, random_values(9, 1U, 0.3, 1.2), 2U);
+  const auto eta = fesd::nlp::make_block(EtaProduct{});
+  expect_same_hessian(*eta, random_values(18, 3U, -1.0, 1.0), 4U);
+  const auto eta32 = fesd::nlp::make_block(EtaProduct{8});  // 34 inputs: capacity 128 reference
+  expect_same_hessian(*eta32, random_values(34, 5U, -1.0, 1.0), 6U);
+}
+
+std::string example(const char* name) {
+  return std::string(FESD_SOURCE_DIR) + "/examples/" + name;
+}
+
+/// The OCP cost and constraints of a problem file (expression bytecode) as one block: inputs
+/// h, X_1, X_2 (n_x each), q (n_u), p: h (b_1 f_q(X_1) + b_2 f_q(X_2)) + f_q_T(X_2), g_terminal.
+struct OcpTerms {
+  const fesd::OcpFunctions* f;
+  int n_x, n_u, n_p, n_g;
+  int num_inputs() const { return 1 + 2 * n_x + n_u + n_p; }
+  int num_outputs() const { return 1 + n_g; }
+  template <class T>
+  void operator()(const T* w, T* c) const {
+    const T* q = w + 1 + 2 * n_x;
+    const T* p = q + n_u;
+    T s = 0.25 * f->f_q(w + 1, q, p) + 0.75 * f->f_q(w + 1 + n_x, q, p);
+    c[0] = w[0] * s;
+    if (f->has_f_q_T()) c[0] = c[0] + f->f_q_T(w + 1 + n_x, p);
+    f->g_terminal(w + 1 + n_x, p, c + 1);
+  }
+};
+
+TEST(HessianPasses, ProblemFileOcpFunctionsMatchTheColumnPasses) {
+  for (const char* file : {"ocp_sliding_mode_nosnoc.toml", "ocp_sliding_mode.toml"}) {
+    SCOPED_TRACE(file);
+    const fesd::OcpProblem problem = fesd::load_ocp_problem(example(file));
+    const fesd::Ocp& ocp = problem.ocp;
+    const OcpTerms terms{ocp.functions.get(), ocp.model.n_x(), ocp.model.n_u(), ocp.model.n_p(),
+                         ocp.n_g_terminal};
+    const auto block = fesd::nlp::make_block(terms);
+    expect_same_hessian(
+        *block, random_values(static_cast<std::size_t>(terms.num_inputs()), 7U, 0.2, 1.5), 8U);
+  }
+}
+
+// Two subsystems with nonlinear c and f, a control and a parameter (as derivatives_test.cpp).
+struct Nonlinear {
+  template <class T>
+  void c(const T* x, const T* p, T* c) const {
+    using std::sin;
+    c[0] = x[0] - p[0] * x[1] * x[1];
+    c[1] = sin(x[1]) + 0.3 * x[0];
+    c[2] = x[0] * x[1] - 0.1;
+  }
+  template <class T>
+  void f(int r, const T* x, const T* u, const T* p, T* f) const {
+    using std::cos;
+    using std::exp;
+    const double s = 1.0 + r;
+    f[0] = -s * x[1] + u[0] * cos(x[0]) + p[0];
+    f[1] = s * x[0] * x[1] - exp(0.1 * x[1]) * (r % 2 ? 1.0 : -1.0);
+  }
+};
+
+/// One FESD interval with free start state, controls and multipliers (every input has
+/// derivatives), its complementarity rows, and the whole Hessian of the Lagrangian compared.
+void expect_same_nlp_hessian(const fesd::Pss& model, fesd::StepEq step_eq, fesd::CrossComp cross,
+                             int n_s) {
+  fesd::DiscretizationOptions d;
+  d.rk_scheme = fesd::RkScheme::RadauIIA;
+  d.n_s = n_s;
+  d.N_FE = 3;
+  d.step_eq = step_eq;
+  d.cross_comp = cross;
+  const fesd::Tableau tab = fesd::make_tableau(d.rk_scheme, n_s);
+  fesd::nlp::BlockNlp nlp;
+  auto vars = [&](int n) {
+    std::vector<int> v;
+    const int first = nlp.add_variables(n, -1e20, 1e20, 0.0);
+    for (int i = 0; i < n; ++i) v.push_back(first + i);
+    return v;
+  };
+  fesd::discretization::IntervalInputs in;
+  in.s0 = vars(model.n_x());
+  in.q = vars(model.n_u());
+  in.p = vars(model.n_p());
+  in.lambda_start = vars(model.n_theta());
+  in.mu_start = vars(model.n_sys());
+  in.T = 0.3;
+  in.boundary_at_end = true;
+  fesd::discretization::FesdInterval iv(model, tab, d);
+  iv.build(nlp, in);
+  fesd::mpcc::add_scholtes_rows(nlp, iv.groups());
+  std::vector<double> x =
+      random_values(static_cast<std::size_t>(nlp.num_variables()), 11U, 0.2, 0.9);
+  nlp.x_init = x;
+  nlp.finalize();
+  const std::vector<double> lambda =
+      random_values(static_cast<std::size_t>(nlp.num_constraints()), 12U, -0.5, 0.5);
+  std::vector<double> h(static_cast<std::size_t>(nlp.hess_nnz())), h_ref(h);
+  ASSERT_TRUE(nlp.eval_h(x.data(), 0.7, lambda.data(), h.data()));
+  nlp.use_column_hessian_passes();
+  ASSERT_TRUE(nlp.eval_h(x.data(), 0.7, lambda.data(), h_ref.data()));
+  double scale = 0;
+  for (double v : h_ref) scale = std::max(scale, std::abs(v));
+  ASSERT_GT(scale, 0.0);
+  EXPECT_TRUE(fesd::testing::near_arrays(h, h_ref, 1e-12 * scale, 1e-12));
+}
+
+TEST(HessianPasses, FesdNlpsMatchTheColumnPasses) {
+  const fesd::Pss cpp_model = fesd::make_pss(
+      Nonlinear{},
+      fesd::PssDims{.n_x = 2,
+                    .n_u = 1,
+                    .n_p = 1,
+                    .subsystems = {fesd::Subsystem::from_c(1), fesd::Subsystem::from_c(2)}});
+  const fesd::Pss nosnoc =
+      fesd::load_ocp_problem(example("ocp_sliding_mode_nosnoc.toml")).ocp.model;
+  const fesd::Pss paper = fesd::load_ocp_problem(example("ocp_sliding_mode.toml")).ocp.model;
+  for (const fesd::StepEq step_eq :
+       {fesd::StepEq::Eta, fesd::StepEq::EtaTanh, fesd::StepEq::L2Relaxed,
+        fesd::StepEq::HeuristicMean, fesd::StepEq::HeuristicDelta}) {
+    SCOPED_TRACE(static_cast<int>(step_eq));
+    expect_same_nlp_hessian(cpp_model, step_eq, fesd::CrossComp::StageSum, 2);
+    expect_same_nlp_hessian(nosnoc, step_eq, fesd::CrossComp::StageSum, 2);
+    expect_same_nlp_hessian(paper, step_eq, fesd::CrossComp::Sparse, 3);
+  }
+}
+
+}  // namespace
