@@ -31,6 +31,10 @@ struct BlockPattern {
   /// The Hessian passes (plan_hessian_passes): every pair of `hess` in exactly one pass.
   std::vector<HessPass> passes;
   int max_pass_rows = 0;  // the largest rows.size(): the gradient capacity the passes need
+  /// Composite blocks (made of other blocks, e.g. discretization/dynamics_block.hpp): the parts'
+  /// own patterns and block-specific maps from the parts' derivatives to entries of `hess`.
+  std::vector<BlockPattern> parts;
+  std::vector<std::vector<int>> entry_maps;
 };
 
 /// Splits the pairs of bp.hess into passes: a pair (i, j) is computed in the pass of i or of j,
@@ -79,14 +83,18 @@ inline void plan_hessian_passes(BlockPattern& bp, int k) {
 /// for tests (BlockNlp::use_column_hessian_passes).
 inline void plan_column_passes(BlockPattern& bp, int k) {
   bp.passes.clear();
+  std::vector<int> pass_of(static_cast<std::size_t>(k), -1);
+  for (const auto& [i, j] : bp.hess) pass_of[j] = 0;
+  for (int j = 0; j < k; ++j) {  // the distinct columns j, in order
+    if (pass_of[j] < 0) continue;
+    pass_of[j] = static_cast<int>(bp.passes.size());
+    HessPass pass{j, {}, std::vector<int>(static_cast<std::size_t>(k), -1)};
+    for (int r = 0; r < k; ++r) pass.rows.push_back(r);
+    bp.passes.push_back(std::move(pass));
+  }
   for (std::size_t e = 0; e < bp.hess.size(); ++e) {
     const auto [i, j] = bp.hess[e];
-    if (bp.passes.empty() || bp.passes.back().col != j) {
-      HessPass pass{j, {}, std::vector<int>(static_cast<std::size_t>(k), -1)};
-      for (int r = 0; r < k; ++r) pass.rows.push_back(r);
-      bp.passes.push_back(std::move(pass));
-    }
-    bp.passes.back().entry[i] = static_cast<int>(e);
+    bp.passes[pass_of[j]].entry[i] = static_cast<int>(e);
   }
   bp.max_pass_rows = bp.passes.empty() ? 0 : k;
 }

@@ -14,7 +14,9 @@
 
 #include <gtest/gtest.h>
 
+#include "discretization/dynamics_block.hpp"
 #include "discretization/fesd_interval.hpp"
+#include "discretization/step_equilibration_block.hpp"
 #include "fesd/model.hpp"
 #include "fesd/problem_file.hpp"
 #include "mpcc/relaxation.hpp"
@@ -253,6 +255,94 @@ void expect_same_nlp_hessian(const fesd::Pss& model, fesd::StepEq step_eq, fesd:
   for (double v : h_ref) scale = std::max(scale, std::abs(v));
   ASSERT_GT(scale, 0.0);
   EXPECT_TRUE(fesd::testing::near_arrays(h, h_ref, 1e-12 * scale, 1e-12));
+}
+
+/// The composite DynamicsBlock against AutoDiffBlock<DynamicsEq>: same pattern, same values,
+/// Jacobian and Hessian of y'c to 1e-12 relative.
+void expect_same_dynamics(const fesd::Pss& model, unsigned seed) {
+  const fesd::discretization::DynamicsBlock composite(model);
+  const fesd::nlp::AutoDiffBlock<fesd::discretization::DynamicsEq> ad({&model});
+  const int k = ad.num_inputs(), m = ad.num_outputs();
+  ASSERT_EQ(composite.num_inputs(), k);
+  ASSERT_EQ(composite.num_outputs(), m);
+  const std::vector<double> w = random_values(static_cast<std::size_t>(k), seed, 0.2, 1.5);
+  const BlockPattern pc = composite.pattern(w.data()), pa = ad.pattern(w.data());
+  EXPECT_EQ(pc.jac_rows, pa.jac_rows);
+  EXPECT_EQ(pc.hess, pa.hess);
+
+  const auto km = static_cast<std::size_t>(k) * m;
+  std::vector<double> cc(m), ca(m), Jc(km), Ja(km);
+  ASSERT_TRUE(composite.eval(w.data(), cc.data()));
+  ASSERT_TRUE(ad.eval(w.data(), ca.data()));
+  EXPECT_TRUE(fesd::testing::near_arrays(cc, ca, 1e-14, 1e-14));
+  ASSERT_TRUE(composite.jacobian(w.data(), cc.data(), Jc.data()));
+  ASSERT_TRUE(ad.jacobian(w.data(), ca.data(), Ja.data()));
+  EXPECT_TRUE(fesd::testing::near_arrays(cc, ca, 1e-14, 1e-14));
+  EXPECT_TRUE(fesd::testing::near_arrays(Jc, Ja, 1e-14, 1e-13));
+
+  const std::vector<double> y = random_values(static_cast<std::size_t>(m), seed + 1, -1.0, 1.0);
+  std::vector<double> hc(pa.hess.size(), 7.0), ha(pa.hess.size(), -7.0);
+  ASSERT_TRUE(composite.hessian(w.data(), y.data(), pc, hc.data()));
+  ASSERT_TRUE(ad.hessian(w.data(), y.data(), pa, ha.data()));
+  double scale = 0;
+  for (double v : ha) scale = std::max(scale, std::abs(v));
+  EXPECT_TRUE(fesd::testing::near_arrays(hc, ha, 1e-12 * scale, 1e-12));
+}
+
+TEST(HessianPasses, DynamicsBlockMatchesAutoDiff) {
+  const fesd::Pss cpp_model = fesd::make_pss(
+      Nonlinear{},
+      fesd::PssDims{.n_x = 2,
+                    .n_u = 1,
+                    .n_p = 1,
+                    .subsystems = {fesd::Subsystem::from_c(1), fesd::Subsystem::from_c(2)}});
+  expect_same_dynamics(cpp_model, 21U);
+  for (const char* file : {"ocp_sliding_mode_nosnoc.toml", "ocp_sliding_mode.toml"}) {
+    SCOPED_TRACE(file);
+    expect_same_dynamics(fesd::load_ocp_problem(example(file)).ocp.model, 23U);
+  }
+}
+
+TEST(HessianPasses, StepEquilibrationBlockMatchesAutoDiff) {
+  // n_theta = 4 regions with lifted sums (one input each) and n_theta = 2 with longer sums, for
+  // the row (31), its tanh form and the l2_relaxed penalty.
+  for (const int n_theta : {4, 2})
+    for (const int variant : {0, 1, 2}) {
+      SCOPED_TRACE(testing::Message() << "n_theta " << n_theta << " variant " << variant);
+      fesd::discretization::StepEquilibrationEq f;
+      const int per = n_theta == 4 ? 1 : 3;  // inputs per sum
+      f.h_prev = 0;
+      f.h_cur = 1;
+      int next = 2;
+      auto list = [&] {
+        std::vector<int> v;
+        for (int i = 0; i < per; ++i) v.push_back(next++);
+        return v;
+      };
+      for (int r = 0; r < n_theta; ++r) {
+        f.lam_B.push_back(list());
+        f.lam_F.push_back(list());
+        f.th_B.push_back(list());
+        f.th_F.push_back(list());
+      }
+      f.k = next;
+      f.use_tanh = variant == 1;
+      f.penalty = variant == 2;
+      f.h_scale = 0.3;
+      const fesd::discretization::StepEquilibrationBlock composite(f);
+      const fesd::nlp::AutoDiffBlock<fesd::discretization::StepEquilibrationEq> ad(f);
+      const std::vector<double> w = random_values(static_cast<std::size_t>(f.k), 31U, -1.0, 1.0);
+      const BlockPattern pc = composite.pattern(w.data()), pa = ad.pattern(w.data());
+      EXPECT_EQ(pc.jac_rows, pa.jac_rows);
+      EXPECT_EQ(pc.hess, pa.hess);
+      const double y = -0.8;
+      std::vector<double> hc(pa.hess.size(), 7.0), ha(pa.hess.size(), -7.0);
+      ASSERT_TRUE(composite.hessian(w.data(), &y, pc, hc.data()));
+      ASSERT_TRUE(ad.hessian(w.data(), &y, pa, ha.data()));
+      double scale = 0;
+      for (double v : ha) scale = std::max(scale, std::abs(v));
+      EXPECT_TRUE(fesd::testing::near_arrays(hc, ha, 1e-12 * scale, 1e-12));
+    }
 }
 
 TEST(HessianPasses, FesdNlpsMatchTheColumnPasses) {
