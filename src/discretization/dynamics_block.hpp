@@ -62,6 +62,9 @@ class DynamicsBlock final : public nlp::Block {
       : m_(&m), n_x_(m.n_x()), n_th_(m.n_theta()), n_z_(m.n_x() + m.n_u() + m.n_p()) {
     for (int r = 0; r < n_th_; ++r)
       fields_.push_back(std::make_shared<nlp::AutoDiffBlock<RegionField>>(RegionField{m_, r}));
+    // The input limit of AutoDiffBlock<DynamicsEq> is kept (FesdInterval::block_size_errors and
+    // docs/problem-files.md "Limits" state it), although only the fields are differentiated.
+    if (num_inputs() > ad::kMaxInputs) nlp::with_capacity(num_inputs(), []<int N>() {});
   }
   int num_inputs() const override { return 2 * n_x_ + n_th_ + n_z_ - n_x_; }
   int num_outputs() const override { return n_x_; }

@@ -22,6 +22,7 @@
 #include "mpcc/relaxation.hpp"
 #include "nlp/block.hpp"
 #include "nlp/block_nlp.hpp"
+#include "nlp/fesd_nlp_fixture.hpp"
 #include "support/compare.hpp"
 
 namespace {
@@ -92,6 +93,15 @@ std::vector<double> random_values(std::size_t n, unsigned seed, double lo, doubl
   return v;
 }
 
+/// h == h_ref to 1e-12 relative to the largest entry (and entrywise).
+::testing::AssertionResult near_hessians(const std::vector<double>& h,
+                                         const std::vector<double>& h_ref) {
+  double scale = 0;
+  for (double v : h_ref) scale = std::max(scale, std::abs(v));
+  if (scale == 0.0) return ::testing::AssertionFailure() << "the reference Hessian is zero";
+  return fesd::testing::near_arrays(h, h_ref, 1e-12 * scale, 1e-12);
+}
+
 /// Planned passes vs the reference plan of the same block at w (Hessian entries of the pattern).
 void expect_same_hessian(const fesd::nlp::Block& block, const std::vector<double>& w,
                          unsigned seed) {
@@ -104,9 +114,7 @@ void expect_same_hessian(const fesd::nlp::Block& block, const std::vector<double
   std::vector<double> h(planned.hess.size(), 7.0), h_ref(planned.hess.size(), -7.0);
   ASSERT_TRUE(block.hessian(w.data(), y.data(), planned, h.data()));
   ASSERT_TRUE(block.hessian(w.data(), y.data(), reference, h_ref.data()));
-  double scale = 0;
-  for (double v : h_ref) scale = std::max(scale, std::abs(v));
-  EXPECT_TRUE(fesd::testing::near_arrays(h, h_ref, 1e-12 * scale, 1e-12));
+  EXPECT_TRUE(near_hessians(h, h_ref));
 }
 
 /// Every operation of ad.hpp, nonlinear in several inputs, two outputs.
@@ -115,21 +123,12 @@ struct Mixed {
   int num_outputs() const { return 2; }
   template <class T>
   void operator()(const T* w, T* c) const {
-    using std::atan;
-    using std::cos;
-    using std::cosh;
-    using std::exp;
-    using std::log;
-    using std::pow;
-    using std::sin;
-    using std::sinh;
-    using std::sqrt;
-    using std::tan;
-    using std::tanh;
-    c[0] = w[0] * w[1] * sin(w[2]) + exp(w[3] * w[4]) / (1.0 + w[5] * w[5]) + pow(w[6], 2.5) -
-           log(w[7]) * sqrt(w[8]) + 3.0 * w[0];
-    c[1] = tanh(w[1] - w[2]) * cos(w[3]) + pow(w[4], w[5]) + atan(w[6] * w[0]) +
-           sinh(w[7]) * cosh(w[8]) + tan(0.3 * w[2]) - 2.0 / w[5];
+    namespace m = fesd::math;
+    using std::pow;  // pow(T, T) by argument-dependent lookup
+    c[0] = w[0] * w[1] * m::sin(w[2]) + m::exp(w[3] * w[4]) / (1.0 + w[5] * w[5]) +
+           m::pow(w[6], 2.5) - m::log(w[7]) * m::sqrt(w[8]) + 3.0 * w[0];
+    c[1] = m::tanh(w[1] - w[2]) * m::cos(w[3]) + pow(w[4], w[5]) + m::atan(w[6] * w[0]) +
+           m::sinh(w[7]) * m::cosh(w[8]) + m::tan(0.3 * w[2]) - 2.0 / w[5];
   }
 };
 
@@ -193,54 +192,15 @@ TEST(HessianPasses, ProblemFileOcpFunctionsMatchTheColumnPasses) {
   }
 }
 
-// Two subsystems with nonlinear c and f, a control and a parameter (as derivatives_test.cpp).
-struct Nonlinear {
-  template <class T>
-  void c(const T* x, const T* p, T* c) const {
-    using std::sin;
-    c[0] = x[0] - p[0] * x[1] * x[1];
-    c[1] = sin(x[1]) + 0.3 * x[0];
-    c[2] = x[0] * x[1] - 0.1;
-  }
-  template <class T>
-  void f(int r, const T* x, const T* u, const T* p, T* f) const {
-    using std::cos;
-    using std::exp;
-    const double s = 1.0 + r;
-    f[0] = -s * x[1] + u[0] * cos(x[0]) + p[0];
-    f[1] = s * x[0] * x[1] - exp(0.1 * x[1]) * (r % 2 ? 1.0 : -1.0);
-  }
-};
-
 /// One FESD interval with free start state, controls and multipliers (every input has
 /// derivatives), its complementarity rows, and the whole Hessian of the Lagrangian compared.
 void expect_same_nlp_hessian(const fesd::Pss& model, fesd::StepEq step_eq, fesd::CrossComp cross,
                              int n_s) {
-  fesd::DiscretizationOptions d;
-  d.rk_scheme = fesd::RkScheme::RadauIIA;
-  d.n_s = n_s;
-  d.N_FE = 3;
-  d.step_eq = step_eq;
-  d.cross_comp = cross;
-  const fesd::Tableau tab = fesd::make_tableau(d.rk_scheme, n_s);
+  const fesd::DiscretizationOptions d =
+      fesd_test::options(fesd::RkScheme::RadauIIA, n_s, step_eq, cross);
   fesd::nlp::BlockNlp nlp;
-  auto vars = [&](int n) {
-    std::vector<int> v;
-    const int first = nlp.add_variables(n, -1e20, 1e20, 0.0);
-    for (int i = 0; i < n; ++i) v.push_back(first + i);
-    return v;
-  };
-  fesd::discretization::IntervalInputs in;
-  in.s0 = vars(model.n_x());
-  in.q = vars(model.n_u());
-  in.p = vars(model.n_p());
-  in.lambda_start = vars(model.n_theta());
-  in.mu_start = vars(model.n_sys());
-  in.T = 0.3;
-  in.boundary_at_end = true;
-  fesd::discretization::FesdInterval iv(model, tab, d);
-  iv.build(nlp, in);
-  fesd::mpcc::add_scholtes_rows(nlp, iv.groups());
+  fesd::discretization::FesdInterval iv(model, fesd::make_tableau(d.rk_scheme, n_s), d);
+  fesd_test::build_interval(model, iv, nlp);
   std::vector<double> x =
       random_values(static_cast<std::size_t>(nlp.num_variables()), 11U, 0.2, 0.9);
   nlp.x_init = x;
@@ -251,10 +211,7 @@ void expect_same_nlp_hessian(const fesd::Pss& model, fesd::StepEq step_eq, fesd:
   ASSERT_TRUE(nlp.eval_h(x.data(), 0.7, lambda.data(), h.data()));
   nlp.use_column_hessian_passes();
   ASSERT_TRUE(nlp.eval_h(x.data(), 0.7, lambda.data(), h_ref.data()));
-  double scale = 0;
-  for (double v : h_ref) scale = std::max(scale, std::abs(v));
-  ASSERT_GT(scale, 0.0);
-  EXPECT_TRUE(fesd::testing::near_arrays(h, h_ref, 1e-12 * scale, 1e-12));
+  EXPECT_TRUE(near_hessians(h, h_ref));
 }
 
 /// The composite DynamicsBlock against AutoDiffBlock<DynamicsEq>: same pattern, same values,
@@ -284,18 +241,11 @@ void expect_same_dynamics(const fesd::Pss& model, unsigned seed) {
   std::vector<double> hc(pa.hess.size(), 7.0), ha(pa.hess.size(), -7.0);
   ASSERT_TRUE(composite.hessian(w.data(), y.data(), pc, hc.data()));
   ASSERT_TRUE(ad.hessian(w.data(), y.data(), pa, ha.data()));
-  double scale = 0;
-  for (double v : ha) scale = std::max(scale, std::abs(v));
-  EXPECT_TRUE(fesd::testing::near_arrays(hc, ha, 1e-12 * scale, 1e-12));
+  EXPECT_TRUE(near_hessians(hc, ha));
 }
 
 TEST(HessianPasses, DynamicsBlockMatchesAutoDiff) {
-  const fesd::Pss cpp_model = fesd::make_pss(
-      Nonlinear{},
-      fesd::PssDims{.n_x = 2,
-                    .n_u = 1,
-                    .n_p = 1,
-                    .subsystems = {fesd::Subsystem::from_c(1), fesd::Subsystem::from_c(2)}});
+  const fesd::Pss cpp_model = fesd_test::nonlinear_model();
   expect_same_dynamics(cpp_model, 21U);
   for (const char* file : {"ocp_sliding_mode_nosnoc.toml", "ocp_sliding_mode.toml"}) {
     SCOPED_TRACE(file);
@@ -339,19 +289,12 @@ TEST(HessianPasses, StepEquilibrationBlockMatchesAutoDiff) {
       std::vector<double> hc(pa.hess.size(), 7.0), ha(pa.hess.size(), -7.0);
       ASSERT_TRUE(composite.hessian(w.data(), &y, pc, hc.data()));
       ASSERT_TRUE(ad.hessian(w.data(), &y, pa, ha.data()));
-      double scale = 0;
-      for (double v : ha) scale = std::max(scale, std::abs(v));
-      EXPECT_TRUE(fesd::testing::near_arrays(hc, ha, 1e-12 * scale, 1e-12));
+      EXPECT_TRUE(near_hessians(hc, ha));
     }
 }
 
 TEST(HessianPasses, FesdNlpsMatchTheColumnPasses) {
-  const fesd::Pss cpp_model = fesd::make_pss(
-      Nonlinear{},
-      fesd::PssDims{.n_x = 2,
-                    .n_u = 1,
-                    .n_p = 1,
-                    .subsystems = {fesd::Subsystem::from_c(1), fesd::Subsystem::from_c(2)}});
+  const fesd::Pss cpp_model = fesd_test::nonlinear_model();
   const fesd::Pss nosnoc =
       fesd::load_ocp_problem(example("ocp_sliding_mode_nosnoc.toml")).ocp.model;
   const fesd::Pss paper = fesd::load_ocp_problem(example("ocp_sliding_mode.toml")).ocp.model;
