@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "discretization/dynamics_block.hpp"
+#include "discretization/stage_state_block.hpp"
 #include "discretization/step_equilibration_block.hpp"
 #include "fesd/ad.hpp"
 #include "fesd/error.hpp"
@@ -47,19 +48,6 @@ std::vector<int> range(int first, int n) {
 }
 
 // ---- the equations as functors on local inputs w ------------------------------------------
-
-/// X - x - h sum_j a_j V_j = 0 for one state component.  inputs: X, x, h, V_j (j with a_j != 0)
-struct StageStateEq {
-  std::vector<double> a;
-  int num_inputs() const { return 3 + static_cast<int>(a.size()); }
-  int num_outputs() const { return 1; }
-  template <class T>
-  void operator()(const T* w, T* c) const {
-    T s(0.0);
-    for (std::size_t j = 0; j < a.size(); ++j) s = s + a[j] * w[3 + j];
-    c[0] = w[0] - w[1] - w[2] * s;
-  }
-};
 
 /// g(X) - lambda - mu_{k(r)} = 0.  inputs: X (n_x), lambda (n_theta), mu (n_sys), p
 struct LpEq {
@@ -247,7 +235,7 @@ void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
         a.push_back(tab_.A(s, j));
         stage_cols[s].push_back(j);
       }
-    stage_state[s] = make_block(StageStateEq{a});
+    stage_state[s] = std::make_shared<StageStateBlock>(StageStateEq{a});
   }
   std::vector<double> b;
   std::vector<int> b_cols;
@@ -256,7 +244,8 @@ void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
       b.push_back(tab_.b(j));
       b_cols.push_back(j);
     }
-  auto continuity = make_block(StageStateEq{b});
+  const std::shared_ptr<const nlp::Block> continuity =
+      std::make_shared<StageStateBlock>(StageStateEq{b});
 
   for (int n = 0; n < N_FE_; ++n) {
     for (int s = 0; s < n_s_; ++s) {

@@ -16,6 +16,7 @@
 
 #include "discretization/dynamics_block.hpp"
 #include "discretization/fesd_interval.hpp"
+#include "discretization/stage_state_block.hpp"
 #include "discretization/step_equilibration_block.hpp"
 #include "fesd/model.hpp"
 #include "fesd/problem_file.hpp"
@@ -291,6 +292,31 @@ TEST(HessianPasses, StepEquilibrationBlockMatchesAutoDiff) {
       ASSERT_TRUE(ad.hessian(w.data(), &y, pa, ha.data()));
       EXPECT_TRUE(near_hessians(hc, ha));
     }
+}
+
+TEST(HessianPasses, StageStateBlockIsBitIdenticalToAutoDiff) {
+  for (const std::vector<double>& a :
+       {std::vector<double>{0.2, -0.7, 1.3}, std::vector<double>{0.5}, std::vector<double>{}}) {
+    const fesd::discretization::StageStateEq f{a};
+    const fesd::discretization::StageStateBlock hand(f);
+    const fesd::nlp::AutoDiffBlock<fesd::discretization::StageStateEq> ad(f);
+    const int k = f.num_inputs();
+    const std::vector<double> w = random_values(static_cast<std::size_t>(k), 41U, -1.0, 2.0);
+    const BlockPattern ph = hand.pattern(w.data()), pa = ad.pattern(w.data());
+    EXPECT_EQ(ph.jac_rows, pa.jac_rows);
+    EXPECT_EQ(ph.hess, pa.hess);
+    double ch = 0, ca = 0;
+    std::vector<double> Jh(static_cast<std::size_t>(k)), Ja(Jh);
+    ASSERT_TRUE(hand.jacobian(w.data(), &ch, Jh.data()));
+    ASSERT_TRUE(ad.jacobian(w.data(), &ca, Ja.data()));
+    EXPECT_EQ(ch, ca);
+    EXPECT_EQ(Jh, Ja);
+    const double y = -1.7;
+    std::vector<double> hh(pa.hess.size(), 7.0), ha(pa.hess.size(), -7.0);
+    ASSERT_TRUE(hand.hessian(w.data(), &y, ph, hh.data()));
+    ASSERT_TRUE(ad.hessian(w.data(), &y, pa, ha.data()));
+    EXPECT_EQ(hh, ha);
+  }
 }
 
 TEST(HessianPasses, FesdNlpsMatchTheColumnPasses) {
