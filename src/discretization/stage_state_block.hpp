@@ -27,15 +27,9 @@ struct StageStateEq {
   }
 };
 
-class StageStateBlock final : public nlp::Block {
+class StageStateBlock final : public nlp::OneOutputBlock<StageStateEq> {
  public:
-  explicit StageStateBlock(StageStateEq f) : f_(std::move(f)) {}
-  int num_inputs() const override { return f_.num_inputs(); }
-  int num_outputs() const override { return 1; }
-  bool eval(const double* w, double* c) const override {
-    f_(w, c);
-    return std::isfinite(c[0]);
-  }
+  explicit StageStateBlock(StageStateEq f) : OneOutputBlock(std::move(f)) {}
   /// dc/dX = 1, dc/dx = -1, dc/dh = -s, dc/dV_j = -(h a_j), s = sum_j a_j V_j.
   bool jacobian(const double* w, double* c, double* J) const override {
     double s = 0.0;
@@ -64,9 +58,6 @@ class StageStateBlock final : public nlp::Block {
     for (int j = 0; j < static_cast<int>(f_.a.size()); ++j) bp.hess.emplace_back(3 + j, 2);
     return bp;
   }
-
- private:
-  StageStateEq f_;
 };
 
 }  // namespace fesd::discretization

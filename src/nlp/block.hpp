@@ -116,6 +116,23 @@ class Block {
   virtual BlockPattern pattern(const double* w) const = 0;
 };
 
+/// Base of the hand-written blocks with one output: sizes and value from the functor F
+/// (`num_inputs()`, `operator()(const double*, double*)`); the derived block writes the rest.
+template <class F>
+class OneOutputBlock : public Block {
+ public:
+  explicit OneOutputBlock(F f) : f_(std::move(f)) {}
+  int num_inputs() const override { return f_.num_inputs(); }
+  int num_outputs() const override { return 1; }
+  bool eval(const double* w, double* c) const override {
+    f_(w, c);
+    return std::isfinite(c[0]);
+  }
+
+ protected:
+  F f_;
+};
+
 /// Calls fn.template operator()<N>() with the smallest gradient capacity N >= k.
 template <class Fn>
 decltype(auto) with_capacity(int k, Fn&& fn) {

@@ -51,15 +51,9 @@ struct ProductSum {
 };
 
 /// Sum as a Block: the Jacobian is constant (+-1), the Hessian zero.
-class SumBlock final : public Block {
+class SumBlock final : public OneOutputBlock<Sum> {
  public:
-  explicit SumBlock(Sum f) : f_(f) {}
-  int num_inputs() const override { return f_.k; }
-  int num_outputs() const override { return 1; }
-  bool eval(const double* w, double* c) const override {
-    f_(w, c);
-    return std::isfinite(c[0]);
-  }
+  explicit SumBlock(Sum f) : OneOutputBlock(f) {}
   bool jacobian(const double* w, double* c, double* J) const override {
     f_(w, c);
     for (int i = 0; i < f_.k; ++i) J[i] = 1.0;
@@ -75,15 +69,12 @@ class SumBlock final : public Block {
     for (int i = 0; i < f_.k; ++i) bp.jac_rows[0].push_back(i);
     return bp;
   }
-
- private:
-  Sum f_;
 };
 
 /// ProductSum as a Block: dc/dw_a = sum of the partners of a, the Hessian a constant 0/1 matrix.
-class ProductSumBlock final : public Block {
+class ProductSumBlock final : public OneOutputBlock<ProductSum> {
  public:
-  explicit ProductSumBlock(ProductSum f) : f_(std::move(f)) {
+  explicit ProductSumBlock(ProductSum f) : OneOutputBlock(std::move(f)) {
     for (const auto& [a, b] : f_.pairs)
       hess_.emplace_back(std::max(a, b), std::min(a, b));  // (i >= j), as ad::Pattern
     std::sort(hess_.begin(), hess_.end());
@@ -93,12 +84,6 @@ class ProductSumBlock final : public Block {
       pair_entry_.push_back(
           static_cast<int>(std::lower_bound(hess_.begin(), hess_.end(), e) - hess_.begin()));
     }
-  }
-  int num_inputs() const override { return f_.num_inputs(); }
-  int num_outputs() const override { return 1; }
-  bool eval(const double* w, double* c) const override {
-    f_(w, c);
-    return std::isfinite(c[0]);
   }
   bool jacobian(const double* w, double* c, double* J) const override {
     const int k = num_inputs();
@@ -143,7 +128,6 @@ class ProductSumBlock final : public Block {
   }
 
  private:
-  ProductSum f_;
   std::vector<std::pair<int, int>> hess_;
   std::vector<int> pair_entry_;  // per pair of f_: its entry in hess_
 };
