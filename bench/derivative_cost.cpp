@@ -1,7 +1,13 @@
 // bench/derivative_cost.cpp: what exact derivatives cost. Builds the FESD NLP of one integration
 // step (or of N_ctrl intervals chained, the size of the paper's OCP) and times the evaluations
 // IPOPT asks for, per call: constraints, Jacobian, Hessian of the Lagrangian. Prints sizes,
-// nonzeros, median and min time over repeats. Usage: derivative_cost [--json FILE]
+// nonzeros, median and min time over repeats.
+// Usage: derivative_cost [--json FILE] [--repeats R] [--only NAME] [--column-passes]
+//   --repeats R        calls per evaluation (200; a few under callgrind, whose instruction counts
+//                      are the stable measure on a shared machine)
+//   --only NAME        only the problems whose name contains NAME
+//   --column-passes    the Hessian as before the planned passes: one pass per column, every input
+//                      carried (BlockNlp::use_column_hessian_passes), for before/after figures
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -49,7 +55,16 @@ std::pair<double, double> time_it(int repeats, Fn&& fn) {
   return {t[t.size() / 2], t.front()};
 }
 
-nlohmann::json measure(const char* name, const fesd::Pss& model, int n_s, int N_FE, int N_ctrl) {
+struct Settings {
+  int repeats = 200;
+  bool column_passes = false;  // the Hessian as before the planned passes (the reference plan)
+  std::string only;            // measure only the problems whose name contains this
+};
+
+nlohmann::json measure(const char* name, const fesd::Pss& model, int n_s, int N_FE, int N_ctrl,
+                       const Settings& set) {
+  if (std::string(name).find(set.only) == std::string::npos) return nullptr;
+  const int R = set.repeats;
   fesd::DiscretizationOptions d;
   d.n_s = n_s;
   d.N_FE = N_FE;
@@ -84,10 +99,10 @@ nlohmann::json measure(const char* name, const fesd::Pss& model, int n_s, int N_
   std::uniform_real_distribution<double> U(0.1, 1.0);
   for (double& v : nlp.x_init) v = U(rng);
   const auto t_fin = time_it(1, [&] { nlp.finalize(); });
+  if (set.column_passes) nlp.use_column_hessian_passes();
   std::vector<double> lambda(nlp.num_constraints());
   for (double& v : lambda) v = U(rng) - 0.5;
   std::vector<double> g(nlp.num_constraints()), jac(nlp.jac_nnz()), hess(nlp.hess_nnz());
-  const int R = 200;
   const auto tg = time_it(R, [&] { nlp.eval_g(nlp.x_init.data(), g.data()); });
   const auto tj = time_it(R, [&] { nlp.eval_jac_g(nlp.x_init.data(), jac.data()); });
   const auto th =
@@ -110,8 +125,15 @@ nlohmann::json measure(const char* name, const fesd::Pss& model, int n_s, int N_
 
 int main(int argc, char** argv) {
   std::string json_path;
-  for (int i = 1; i + 1 < argc; ++i)
-    if (std::string(argv[i]) == "--json") json_path = argv[i + 1];
+  Settings set;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--column-passes") set.column_passes = true;
+    if (i + 1 == argc) continue;
+    if (a == "--json") json_path = argv[i + 1];
+    if (a == "--repeats") set.repeats = std::max(1, std::stoi(argv[i + 1]));
+    if (a == "--only") set.only = argv[i + 1];
+  }
   const fesd::Pss osc = fesd_bench::oscillator_model();  // eq. (47)
   const fesd::Pss ocp = fesd::make_pss(
       SlidingOcp{},
@@ -120,13 +142,16 @@ int main(int argc, char** argv) {
                     .subsystems = {fesd::Subsystem::from_c(1, Eigen::MatrixXd{{1}, {-1}}),
                                    fesd::Subsystem::from_c(1, Eigen::MatrixXd{{1}, {-1}})}});
   // The second subsystem's c is c[1]: c() fills both subsystems' switching functions in order.
-  std::printf("%-28s %6s %6s %8s %8s %10s %10s %10s %10s\n", "problem (median of 200)", "n", "m",
+  std::printf("%-28s %6s %6s %8s %8s %10s %10s %10s %10s\n", "problem (median)", "n", "m",
               "jac_nnz", "hess_nnz", "g [us]", "jac [us]", "hess [us]", "setup [us]");
   nlohmann::json rows = nlohmann::json::array();
-  rows.push_back(measure("oscillator step n_s=3 N_FE=2", osc, 3, 2, 1));
-  rows.push_back(measure("oscillator step n_s=4 N_FE=2", osc, 4, 2, 1));
-  rows.push_back(measure("OCP (61) n_s=2 N_FE=6 N=6", ocp, 2, 6, 6));
-  rows.push_back(measure("OCP (61) n_s=4 N_FE=6 N=6", ocp, 4, 6, 6));
+  auto add = [&](nlohmann::json row) {
+    if (!row.is_null()) rows.push_back(std::move(row));
+  };
+  add(measure("oscillator step n_s=3 N_FE=2", osc, 3, 2, 1, set));
+  add(measure("oscillator step n_s=4 N_FE=2", osc, 4, 2, 1, set));
+  add(measure("OCP (61) n_s=2 N_FE=6 N=6", ocp, 2, 6, 6, set));
+  add(measure("OCP (61) n_s=4 N_FE=6 N=6", ocp, 4, 6, 6, set));
   if (!json_path.empty()) std::ofstream(json_path) << rows.dump(2) << "\n";
   return 0;
 }

@@ -8,6 +8,9 @@
 
 #include <fmt/format.h>
 
+#include "discretization/dynamics_block.hpp"
+#include "discretization/stage_state_block.hpp"
+#include "discretization/step_equilibration_block.hpp"
 #include "fesd/ad.hpp"
 #include "fesd/error.hpp"
 #include "nlp/sum_block.hpp"
@@ -45,37 +48,6 @@ std::vector<int> range(int first, int n) {
 }
 
 // ---- the equations as functors on local inputs w ------------------------------------------
-
-/// X - x - h sum_j a_j V_j = 0 for one state component.  inputs: X, x, h, V_j (j with a_j != 0)
-struct StageStateEq {
-  std::vector<double> a;
-  int num_inputs() const { return 3 + static_cast<int>(a.size()); }
-  int num_outputs() const { return 1; }
-  template <class T>
-  void operator()(const T* w, T* c) const {
-    T s(0.0);
-    for (std::size_t j = 0; j < a.size(); ++j) s = s + a[j] * w[3 + j];
-    c[0] = w[0] - w[1] - w[2] * s;
-  }
-};
-
-/// V - sum_r f_r(X, q, p) theta_r = 0.  inputs: V (n_x), X (n_x), theta (n_theta), q, p
-struct DynamicsEq {
-  const Pss* m;
-  int num_inputs() const { return 2 * m->n_x() + m->n_theta() + m->n_u() + m->n_p(); }
-  int num_outputs() const { return m->n_x(); }
-  template <class T>
-  void operator()(const T* w, T* c) const {
-    const int n_x = m->n_x();
-    const T* V = w;
-    const T* X = w + n_x;
-    const T* theta = X + n_x;
-    const T* q = theta + m->n_theta();
-    const T* p = q + m->n_u();
-    dcs::eval_F_theta(*m, X, q, p, theta, c);
-    for (int i = 0; i < n_x; ++i) c[i] = V[i] - c[i];
-  }
-};
 
 /// g(X) - lambda - mu_{k(r)} = 0.  inputs: X (n_x), lambda (n_theta), mu (n_sys), p
 struct LpEq {
@@ -129,46 +101,6 @@ struct SquaredDifference {
   void operator()(const T* w, T* c) const {
     const T d = w[1] - w[0];
     c[0] = d * d;
-  }
-};
-
-/// Step equilibration (31): (h_n - h_{n-1}) * eta_n (or tanh(eta_n)), with
-///   eta_n = prod_r ( sigma^{lambda,B}_r sigma^{lambda,F}_r + sigma^{theta,B}_r sigma^{theta,F}_r
-///   ).
-/// Index lists are local positions of the summed lambdas/thetas per region r.
-struct StepEquilibrationEq {
-  int k = 0;
-  int h_prev = 0, h_cur = 1;
-  std::vector<std::vector<int>> lam_B, lam_F, th_B, th_F;  // per region
-  bool use_tanh = false;
-  /// L2Relaxed: the objective term tanh(eta_n) ((h_n - h_{n-1}) / h_scale)^2 instead of the row.
-  bool penalty = false;
-  double h_scale = 1.0;
-  int num_inputs() const { return k; }
-  int num_outputs() const { return 1; }
-  template <class T>
-  static T sum(const T* w, const std::vector<int>& idx) {
-    T s(0.0);
-    for (int i : idx) s = s + w[i];
-    return s;
-  }
-  template <class T>
-  T eta(const T* w) const {
-    T e(1.0);
-    for (std::size_t r = 0; r < lam_B.size(); ++r)
-      e = e * (sum(w, lam_B[r]) * sum(w, lam_F[r]) + sum(w, th_B[r]) * sum(w, th_F[r]));
-    return e;
-  }
-  template <class T>
-  void operator()(const T* w, T* c) const {
-    using std::tanh;
-    const T e = eta(w);
-    if (penalty) {
-      const T d = (w[h_cur] - w[h_prev]) / h_scale;
-      c[0] = tanh(e) * d * d;
-      return;
-    }
-    c[0] = (w[h_cur] - w[h_prev]) * (use_tanh ? tanh(e) : e);
   }
 };
 
@@ -291,7 +223,7 @@ void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
   const auto owner = dcs::region_subsystem(m);
   std::vector<int> offsets;
   for (int k = 0; k <= n_sys; ++k) offsets.push_back(m.region_offset(k));
-  auto dynamics = make_block(DynamicsEq{&m});
+  const std::shared_ptr<const nlp::Block> dynamics = std::make_shared<DynamicsBlock>(m);
   auto lp = make_block(LpEq{&m, owner});
   auto simplex = make_block(SimplexEq{offsets});
   std::vector<std::shared_ptr<const nlp::Block>> stage_state(n_s_);
@@ -303,7 +235,7 @@ void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
         a.push_back(tab_.A(s, j));
         stage_cols[s].push_back(j);
       }
-    stage_state[s] = make_block(StageStateEq{a});
+    stage_state[s] = std::make_shared<StageStateBlock>(StageStateEq{a});
   }
   std::vector<double> b;
   std::vector<int> b_cols;
@@ -312,7 +244,8 @@ void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
       b.push_back(tab_.b(j));
       b_cols.push_back(j);
     }
-  auto continuity = make_block(StageStateEq{b});
+  const std::shared_ptr<const nlp::Block> continuity =
+      std::make_shared<StageStateBlock>(StageStateEq{b});
 
   for (int n = 0; n < N_FE_; ++n) {
     for (int s = 0; s < n_s_; ++s) {
@@ -425,9 +358,10 @@ void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
         }
         f.k = static_cast<int>(vl.vars().size());
         if (f.penalty)
-          nlp.add_objective(make_block(f), vl.vars(), opt_.rho_h);
+          nlp.add_objective(std::make_shared<StepEquilibrationBlock>(f), vl.vars(), opt_.rho_h);
         else
-          step_eq_rows_.push_back(nlp.add_constraint(make_block(f), vl.vars(), 0.0, 0.0));
+          step_eq_rows_.push_back(
+              nlp.add_constraint(std::make_shared<StepEquilibrationBlock>(f), vl.vars(), 0.0, 0.0));
       }
     } else if (opt_.step_eq == StepEq::HeuristicMean) {
       auto pen = make_block(SquaredDeviation{h0});

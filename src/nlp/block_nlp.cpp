@@ -56,6 +56,7 @@ void BlockNlp::finalize() {
   hess_row_.clear();
   hess_col_.clear();
   max_k_ = max_m_ = 0;
+  max_hess_ = 0;
   // One pattern per distinct block object: instances sharing a block share its structure.
   std::unordered_map<const Block*, const BlockPattern*> cache;
   std::vector<double> w;
@@ -81,6 +82,7 @@ void BlockNlp::finalize() {
       }
       in.hess_index.push_back(it->second);
     }
+    max_hess_ = std::max(max_hess_, in.pattern->hess.size());
   };
   for (Instance& in : constraints_) {
     in.pattern = pattern_of(in);
@@ -101,6 +103,14 @@ void BlockNlp::finalize() {
     max_k_ = std::max(max_k_, in.block->num_inputs());
   }
   finalized_ = true;
+}
+
+void BlockNlp::use_column_hessian_passes() {
+  std::unordered_map<const BlockPattern*, int> inputs;
+  for (const auto* list : {&constraints_, &objectives_})
+    for (const Instance& in : *list) inputs[in.pattern] = in.block->num_inputs();
+  for (auto& p : patterns_)  // hand-written blocks (no passes) compute their Hessian directly
+    if (!p->passes.empty()) plan_column_passes(*p, inputs.at(p.get()));
 }
 
 bool BlockNlp::eval_f(const double* x, double& f) const {
@@ -155,9 +165,9 @@ bool BlockNlp::eval_jac_g(const double* x, double* values) const {
 bool BlockNlp::add_hessian(const Instance& in, const double* x, double factor, const double* y,
                            double* values) const {
   if (in.pattern->hess.empty()) return true;
-  const int k = in.block->num_inputs(), m = in.block->num_outputs();
+  const int m = in.block->num_outputs();
   std::vector<double>& w = scratch<double>(max_k_, 0);
-  std::vector<double>& H = scratch<double>(static_cast<std::size_t>(max_k_) * max_k_, 1);
+  std::vector<double>& h = scratch<double>(max_hess_, 1);
   std::vector<double>& ys = scratch<double>(std::max(max_m_, 1), 2);
   bool any = false;
   for (int r = 0; r < m; ++r) {
@@ -166,11 +176,8 @@ bool BlockNlp::add_hessian(const Instance& in, const double* x, double factor, c
   }
   if (!any) return true;
   gather(in, x, w.data());
-  if (!in.block->hessian(w.data(), ys.data(), in.pattern->hess_cols, H.data())) return false;
-  for (std::size_t e = 0; e < in.pattern->hess.size(); ++e) {
-    const auto& [i, j] = in.pattern->hess[e];
-    values[in.hess_index[e]] += H[static_cast<std::size_t>(j) * k + i];
-  }
+  if (!in.block->hessian(w.data(), ys.data(), *in.pattern, h.data())) return false;
+  for (std::size_t e = 0; e < in.pattern->hess.size(); ++e) values[in.hess_index[e]] += h[e];
   return true;
 }
 

@@ -50,6 +50,9 @@ class BlockNlp {
   const std::vector<int>& jac_cols() const { return jac_col_; }
   const std::vector<int>& hess_rows() const { return hess_row_; }
   const std::vector<int>& hess_cols() const { return hess_col_; }
+  /// Tests: every block's Hessian passes replaced by the reference plan (plan_column_passes), the
+  /// Hessian as computed before the planned passes. Call after finalize().
+  void use_column_hessian_passes();
   void set_objective_weight(int objective, double w) { objectives_[objective].weight = w; }
 
   // Evaluations; each returns false if a block produced a non-finite value.
@@ -82,6 +85,7 @@ class BlockNlp {
   std::vector<int> jac_row_, jac_col_, hess_row_, hess_col_;
   bool finalized_ = false;
   int max_k_ = 0, max_m_ = 0;
+  std::size_t max_hess_ = 0;  // the most Hessian pattern entries of one block
 };
 
 }  // namespace fesd::nlp

@@ -51,25 +51,17 @@ struct ProductSum {
 };
 
 /// Sum as a Block: the Jacobian is constant (+-1), the Hessian zero.
-class SumBlock final : public Block {
+class SumBlock final : public OneOutputBlock<Sum> {
  public:
-  explicit SumBlock(Sum f) : f_(f) {}
-  int num_inputs() const override { return f_.k; }
-  int num_outputs() const override { return 1; }
-  bool eval(const double* w, double* c) const override {
-    f_(w, c);
-    return std::isfinite(c[0]);
-  }
+  explicit SumBlock(Sum f) : OneOutputBlock(f) {}
   bool jacobian(const double* w, double* c, double* J) const override {
     f_(w, c);
     for (int i = 0; i < f_.k; ++i) J[i] = 1.0;
     if (f_.minus_first && f_.k > 0) J[0] = -1.0;
     return std::isfinite(c[0]);
   }
-  bool hessian(const double*, const double*, const std::vector<int>& cols,
-               double* H) const override {
-    for (int j : cols) std::fill_n(H + static_cast<std::size_t>(j) * f_.k, f_.k, 0.0);
-    return true;
+  bool hessian(const double*, const double*, const BlockPattern&, double*) const override {
+    return true;  // no Hessian entries
   }
   BlockPattern pattern(const double*) const override {
     BlockPattern bp;
@@ -77,25 +69,21 @@ class SumBlock final : public Block {
     for (int i = 0; i < f_.k; ++i) bp.jac_rows[0].push_back(i);
     return bp;
   }
-
- private:
-  Sum f_;
 };
 
 /// ProductSum as a Block: dc/dw_a = sum of the partners of a, the Hessian a constant 0/1 matrix.
-class ProductSumBlock final : public Block {
+class ProductSumBlock final : public OneOutputBlock<ProductSum> {
  public:
-  explicit ProductSumBlock(ProductSum f) : f_(std::move(f)) {
+  explicit ProductSumBlock(ProductSum f) : OneOutputBlock(std::move(f)) {
     for (const auto& [a, b] : f_.pairs)
       hess_.emplace_back(std::max(a, b), std::min(a, b));  // (i >= j), as ad::Pattern
     std::sort(hess_.begin(), hess_.end());
     hess_.erase(std::unique(hess_.begin(), hess_.end()), hess_.end());
-  }
-  int num_inputs() const override { return f_.num_inputs(); }
-  int num_outputs() const override { return 1; }
-  bool eval(const double* w, double* c) const override {
-    f_(w, c);
-    return std::isfinite(c[0]);
+    for (const auto& [a, b] : f_.pairs) {
+      const std::pair<int, int> e(std::max(a, b), std::min(a, b));
+      pair_entry_.push_back(
+          static_cast<int>(std::lower_bound(hess_.begin(), hess_.end(), e) - hess_.begin()));
+    }
   }
   bool jacobian(const double* w, double* c, double* J) const override {
     const int k = num_inputs();
@@ -114,24 +102,14 @@ class ProductSumBlock final : public Block {
     for (int i = 0; i < k; ++i) ok = ok && std::isfinite(J[i]);
     return ok;
   }
-  bool hessian(const double*, const double* y, const std::vector<int>& cols,
-               double* H) const override {
-    const int k = num_inputs();
-    std::vector<char>& wanted = scratch<char>(static_cast<std::size_t>(k), 0);
-    std::fill_n(wanted.begin(), k, 0);
-    for (int j : cols) {
-      std::fill_n(H + static_cast<std::size_t>(j) * k, k, 0.0);
-      wanted[j] = 1;
-    }
+  bool hessian(const double*, const double* y, const BlockPattern&, double* h) const override {
     // d^2(w_a w_b) = e_a e_b' + e_b e_a': count the entries, then scale by y (as AD does).
-    for (const auto& [a, b] : f_.pairs) {
-      if (wanted[b]) H[static_cast<std::size_t>(b) * k + a] += 1.0;
-      if (wanted[a]) H[static_cast<std::size_t>(a) * k + b] += 1.0;
+    std::fill_n(h, hess_.size(), 0.0);
+    for (std::size_t p = 0; p < f_.pairs.size(); ++p) {
+      const auto& [a, b] = f_.pairs[p];
+      h[pair_entry_[p]] += a == b ? 2.0 : 1.0;
     }
-    for (int j : cols) {
-      double* col = H + static_cast<std::size_t>(j) * k;
-      for (int i = 0; i < k; ++i) col[i] *= y[0];
-    }
+    for (std::size_t e = 0; e < hess_.size(); ++e) h[e] *= y[0];
     return std::isfinite(y[0]);
   }
   BlockPattern pattern(const double*) const override {
@@ -145,16 +123,13 @@ class ProductSumBlock final : public Block {
     std::sort(row.begin(), row.end());
     row.erase(std::unique(row.begin(), row.end()), row.end());
     bp.jac_rows.assign(1, std::move(row));
-    bp.hess = hess_;
-    for (const auto& [i, j] : bp.hess) bp.hess_cols.push_back(j);
-    std::sort(bp.hess_cols.begin(), bp.hess_cols.end());
-    bp.hess_cols.erase(std::unique(bp.hess_cols.begin(), bp.hess_cols.end()), bp.hess_cols.end());
+    bp.hess = hess_;  // no passes: hessian() needs none
     return bp;
   }
 
  private:
-  ProductSum f_;
   std::vector<std::pair<int, int>> hess_;
+  std::vector<int> pair_entry_;  // per pair of f_: its entry in hess_
 };
 
 /// The hand-written blocks for Sum and ProductSum (exact match: preferred over the AD template).

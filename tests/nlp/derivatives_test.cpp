@@ -13,6 +13,7 @@
 #include "discretization/fesd_interval.hpp"
 #include "fesd/model.hpp"
 #include "mpcc/relaxation.hpp"
+#include "nlp/fesd_nlp_fixture.hpp"
 #include "support/compare.hpp"
 
 namespace {
@@ -20,26 +21,6 @@ namespace {
 using fesd::CrossComp;
 using fesd::RkScheme;
 using fesd::StepEq;
-
-// Two subsystems (Cartesian product, eq. 21) with nonlinear g and f, a control and a parameter:
-// subsystem 0 from c0 = x1 - p0 x2^2 (default S), subsystem 1 from two switching functions.
-struct Nonlinear {
-  template <class T>
-  void c(const T* x, const T* p, T* c) const {
-    using std::sin;
-    c[0] = x[0] - p[0] * x[1] * x[1];
-    c[1] = sin(x[1]) + 0.3 * x[0];
-    c[2] = x[0] * x[1] - 0.1;
-  }
-  template <class T>
-  void f(int r, const T* x, const T* u, const T* p, T* f) const {
-    using std::cos;
-    using std::exp;
-    const double s = 1.0 + r;
-    f[0] = -s * x[1] + u[0] * cos(x[0]) + p[0];
-    f[1] = s * x[0] * x[1] - exp(0.1 * x[1]) * (r % 2 ? 1.0 : -1.0);
-  }
-};
 
 struct Case {
   RkScheme scheme;
@@ -52,38 +33,11 @@ class DerivativesTest : public ::testing::TestWithParam<Case> {};
 
 TEST_P(DerivativesTest, MatchCentralDifferences) {
   const Case c = GetParam();
-  const fesd::Pss model = fesd::make_pss(
-      Nonlinear{},
-      fesd::PssDims{.n_x = 2,
-                    .n_u = 1,
-                    .n_p = 1,
-                    .subsystems = {fesd::Subsystem::from_c(1), fesd::Subsystem::from_c(2)}});
-  fesd::DiscretizationOptions d;
-  d.rk_scheme = c.scheme;
-  d.n_s = c.n_s;
-  d.N_FE = 3;
-  d.step_eq = c.step_eq;
-  d.cross_comp = c.cross;
-  const fesd::Tableau tab = fesd::make_tableau(c.scheme, c.n_s);
+  const fesd::Pss model = fesd_test::nonlinear_model();
+  const fesd::DiscretizationOptions d = fesd_test::options(c.scheme, c.n_s, c.step_eq, c.cross);
   fesd::nlp::BlockNlp nlp;
-  fesd::discretization::IntervalInputs in;
-  auto vars = [&](int n) {
-    std::vector<int> v;
-    const int first = nlp.add_variables(n, -1e20, 1e20, 0.0);
-    for (int i = 0; i < n; ++i) v.push_back(first + i);
-    return v;
-  };
-  // Free start state and start multipliers: the OCP case, so every input gets derivatives.
-  in.s0 = vars(2);
-  in.q = vars(1);
-  in.p = vars(1);
-  in.lambda_start = vars(model.n_theta());
-  in.mu_start = vars(model.n_sys());
-  in.T = 0.3;
-  in.boundary_at_end = true;
-  fesd::discretization::FesdInterval iv(model, tab, d);
-  iv.build(nlp, in);
-  fesd::mpcc::add_scholtes_rows(nlp, iv.groups());
+  fesd::discretization::FesdInterval iv(model, fesd::make_tableau(c.scheme, c.n_s), d);
+  fesd_test::build_interval(model, iv, nlp);
 
   const int n = nlp.num_variables(), m = nlp.num_constraints();
   std::mt19937 rng(7);
