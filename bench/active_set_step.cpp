@@ -26,6 +26,7 @@
 
 #include "bench_args.hpp"
 #include "oscillator_model.hpp"
+#include "sensitivity_ocp.hpp"
 
 namespace fesd_bench {
 [[noreturn]] void usage(const std::string& why, int exit_code) {
@@ -39,17 +40,6 @@ namespace fesd_bench {
 
 namespace {
 
-struct Crossing {  // Example 3(a): region 0 is x > 0 (x' = 1), region 1 is x < 0 (x' = 3)
-  template <class T>
-  void c(const T* x, const T*, T* c) const {
-    c[0] = x[0];
-  }
-  template <class T>
-  void f(int region, const T*, const T*, const T*, T* f) const {
-    f[0] = T(region == 0 ? 1.0 : 3.0);
-  }
-};
-
 struct Case {
   std::string name;
   fesd::Pss model;
@@ -61,7 +51,8 @@ struct Case {
 struct Row {
   std::string problem, path;
   int N_sim = 0, repeats = 0;
-  double wall_s = 0, cpu_s = 0;  // medians per run
+  double wall_s = 0, cpu_s = 0;    // medians per run
+  double path_s = 0, setup_s = 0;  // of the last run: time in the active-set path, setup
   double newton_per_step = 0, ipopt_per_step = 0, nlps_per_step = 0;
   int active_set_steps = 0, homotopy_steps = 0, tries = 0;
   double error_x = 0, error_t_s = 0;
@@ -101,6 +92,8 @@ Row measure(const Case& c, int N_sim, fesd::StepSolver solver, int repeats) {
   row.wall_s = median(wall);
   row.cpu_s = median(cpu);
   const fesd::Summary& s = r.summary;
+  row.path_s = s.active_set_s;
+  row.setup_s = s.setup_s;
   row.newton_per_step = static_cast<double>(s.newton_iterations) / N_sim;
   row.ipopt_per_step = static_cast<double>(s.nlp_iterations) / N_sim;
   row.nlps_per_step = static_cast<double>(s.homotopy_steps) / N_sim;
@@ -142,7 +135,7 @@ int main(int argc, char** argv) {
                    fesd_bench::kOscillatorSwitch, 3});
   cases.push_back(
       {"Example 3(a)",
-       fesd::make_pss(Crossing{},
+       fesd::make_pss(fesd_bench::SensitivityModel{},
                       fesd::PssDims{.n_x = 1, .subsystems = {fesd::Subsystem::from_c(1)}}),
        Eigen::VectorXd::Constant(1, -1.0), Eigen::VectorXd::Constant(1, 1.9 - 1.0 / 3.0), 1.9,
        1.0 / 3.0, 3});
@@ -155,30 +148,34 @@ int main(int argc, char** argv) {
 
   fmt::print("Radau IIA n_s = 3, N_FE = 2, N_sim = {}; medians over the repetitions (in-process)\n",
              N_sim);
-  fmt::print("{:<16} {:<11} {:>5} {:>10} {:>10} {:>10} {:>7} {:>7} {:>6} {:>9} {:>9} {:>9} {:>9}\n",
-             "problem", "path", "reps", "wall ms", "cpu ms", "us/step", "Newton", "IPOPT", "NLPs",
-             "as/hom", "err x(T)", "err t_s", "speedup");
+  fmt::print(
+      "{:<16} {:<11} {:>5} {:>10} {:>10} {:>10} {:>10} {:>9} {:>7} {:>7} {:>6} {:>9} {:>9} {:>9} "
+      "{:>9}\n",
+      "problem", "path", "reps", "wall ms", "cpu ms", "us/step", "path wall", "setup ms", "Newton",
+      "IPOPT", "NLPs", "as/hom", "err x(T)", "err t_s", "speedup");
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const Row& r = rows[i];
     const Row& base = rows[i - i % 2];
     fmt::print(
-        "{:<16} {:<11} {:>5} {:>10.3f} {:>10.3f} {:>10.1f} {:>7.2f} {:>7.1f} {:>6.2f} {:>9} "
-        "{:>9.1e} {:>9.1e} {:>8.0f}x\n",
+        "{:<16} {:<11} {:>5} {:>10.3f} {:>10.3f} {:>10.1f} {:>10.1f} {:>9.3f} {:>7.2f} {:>7.1f} "
+        "{:>6.2f} {:>9} {:>9.1e} {:>9.1e} {:>8.0f}x\n",
         r.problem, r.path, r.repeats, 1e3 * r.wall_s, 1e3 * r.cpu_s, 1e6 * r.cpu_s / r.N_sim,
-        r.newton_per_step, r.ipopt_per_step, r.nlps_per_step,
-        fmt::format("{}/{}", r.active_set_steps, r.homotopy_steps), r.error_x, r.error_t_s,
-        base.cpu_s / r.cpu_s);
+        1e6 * r.path_s / r.N_sim, 1e3 * r.setup_s, r.newton_per_step, r.ipopt_per_step,
+        r.nlps_per_step, fmt::format("{}/{}", r.active_set_steps, r.homotopy_steps), r.error_x,
+        r.error_t_s, base.cpu_s / r.cpu_s);
   }
   if (!csv.empty()) {
     std::ofstream f(csv);
     f << "problem,path,N_sim,repeats,wall_s,cpu_s,cpu_s_per_step,newton_per_step,"
-         "ipopt_per_step,nlps_per_step,active_set_steps,homotopy_steps,tries,error_x,error_t_s\n";
+         "ipopt_per_step,nlps_per_step,active_set_steps,homotopy_steps,tries,error_x,error_t_s,"
+         "path_s,setup_s\n";
     for (const Row& r : rows)
       f << fmt::format(
-          "{},{},{},{},{:.6e},{:.6e},{:.6e},{:.3f},{:.3f},{:.3f},{},{},{},{:.3e},{:.3e}\n",
+          "{},{},{},{},{:.6e},{:.6e},{:.6e},{:.3f},{:.3f},{:.3f},{},{},{},{:.3e},{:.3e},{:.6e},"
+          "{:.6e}\n",
           r.problem, r.path, r.N_sim, r.repeats, r.wall_s, r.cpu_s, r.cpu_s / r.N_sim,
           r.newton_per_step, r.ipopt_per_step, r.nlps_per_step, r.active_set_steps,
-          r.homotopy_steps, r.tries, r.error_x, r.error_t_s);
+          r.homotopy_steps, r.tries, r.error_x, r.error_t_s, r.path_s, r.setup_s);
   }
   if (!json_path.empty()) {
     nlohmann::json j = nlohmann::json::array();
@@ -197,7 +194,9 @@ int main(int argc, char** argv) {
                    {"homotopy_steps", r.homotopy_steps},
                    {"tries", r.tries},
                    {"error_x", r.error_x},
-                   {"error_t_s", r.error_t_s}});
+                   {"error_t_s", r.error_t_s},
+                   {"path_s", r.path_s},
+                   {"setup_s", r.setup_s}});
     std::ofstream(json_path) << j.dump(2) << "\n";
   }
   return 0;

@@ -178,7 +178,10 @@ ActiveSetTry ActiveSetStep::newton(const Sets& active) {
     dz_ = lu.solve(-F_);
     ++out.iterations;
     ++iterations_;
-    if (!dz_.allFinite() || lu.rcond() < 1e-14) return out;
+    // A singular Jacobian (not square in effect): the smallest pivot of the LU against the
+    // largest. Cheaper than rcond(), whose estimate costs more than the factorization here.
+    const auto pivots = lu.matrixLU().diagonal().cwiseAbs();
+    if (!dz_.allFinite() || !(pivots.minCoeff() > 1e-14 * pivots.maxCoeff())) return out;
     for (int i = 0; i < n_free; ++i) w_[free_[i]] += dz_[i];
     if (dz_.lpNorm<Eigen::Infinity>() <= 1e-14 * w_max) {
       out.converged = true;

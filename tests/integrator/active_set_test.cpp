@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "../../bench/oscillator_model.hpp"
+#include "../../bench/sensitivity_ocp.hpp"
 #include "fesd/error.hpp"
 #include "fesd/integrator.hpp"
 #include "fesd/model.hpp"
@@ -19,21 +20,10 @@ using fesd::IntegratorResult;
 using fesd::RkScheme;
 using fesd::StepSolver;
 
-// Example 3(a): x' in 2 - sign(x). One switching function c = x, default S = [[1], [-1]]:
-// region 0 is x > 0 (x' = 1), region 1 is x < 0 (x' = 3).
-struct Crossing {
-  template <class T>
-  void c(const T* x, const T*, T* c) const {
-    c[0] = x[0];
-  }
-  template <class T>
-  void f(int region, const T*, const T*, const T*, T* f) const {
-    f[0] = T(region == 0 ? 1.0 : 3.0);
-  }
-};
-
+// Example 3(a): x' in 2 - sign(x), the model of the sensitivity OCP (56)
+// (bench/sensitivity_ocp.hpp): region 0 is x > 0 (x' = 1), region 1 is x < 0 (x' = 3).
 fesd::Pss crossing_model() {
-  return fesd::make_pss(Crossing{},
+  return fesd::make_pss(fesd_bench::SensitivityModel{},
                         fesd::PssDims{.n_x = 1, .subsystems = {fesd::Subsystem::from_c(1)}});
 }
 
