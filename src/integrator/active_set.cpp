@@ -99,26 +99,26 @@ bool ActiveSetStep::solve(const Eigen::VectorXd& x0, const std::vector<int>& pre
   // A switch inside the step: region v.r enters. Its time from lambda_r, linear between the last
   // point where lambda_r >= 0 held and the first where it failed.
   const double ts = v.t_ok + (v.t_bad - v.t_ok) * v.lam_ok / std::max(v.lam_ok - v.lam_bad, 1e-300);
+  // A crossing: r replaces the active regions of its subsystem. (Entering a sliding mode, r added
+  // to them, is left to the homotopy for now: tried as a second candidate it accepted a spurious
+  // sliding solution of examples/temperature_control.toml, where the homotopy crosses.)
   const int k = subsystem_of(model_, v.r);
-  std::vector<int> crossing, sliding = predicted;
+  std::vector<int> crossing;
   for (int r : predicted)
     if (subsystem_of(model_, r) != k) crossing.push_back(r);
   crossing.push_back(v.r);
-  sliding.push_back(v.r);
   std::sort(crossing.begin(), crossing.end());
-  std::sort(sliding.begin(), sliding.end());
   const std::vector<double> w_pred = w_;
-  for (const std::vector<int>& after : {crossing, sliding})
-    for (int b : boundaries_for(ts)) {
-      if (tries_ >= kMaxTries) return false;
-      Sets active = predicted_sets;
-      for (int n = b; n < iv_->N_FE(); ++n) active[n] = after;
-      switched_guess(w_pred, predicted, after, b, ts);
-      ++tries_;
-      if (!newton(active).converged) continue;
-      const Violation again = check_signs(active);
-      if (!again.bad && again.r < 0) return true;
-    }
+  for (int b : boundaries_for(ts)) {
+    if (tries_ >= kMaxTries) return false;
+    Sets active = predicted_sets;
+    for (int n = b; n < iv_->N_FE(); ++n) active[n] = crossing;
+    switched_guess(w_pred, predicted, crossing, b, ts);
+    ++tries_;
+    if (!newton(active).converged) continue;
+    const Violation again = check_signs(active);
+    if (!again.bad && again.r < 0) return true;
+  }
   return false;
 }
 

@@ -13,9 +13,9 @@
 // ActiveSetStep solves it by Newton's method with the exact Jacobian (forward AD of the blocks,
 // a dense LU of Eigen), for the active set predicted from the previous step's end, then checks the
 // signs (theta >= 0 on, lambda >= 0 off the active set, h_n within its bounds). A violated lambda
-// >= 0 is a switch inside the step: the region is swapped in (a crossing; entering a sliding mode
-// is tried next) from an element boundary chosen from the estimated switch time, and the system
-// with that boundary's length free is solved. If no consistent active set is found within
+// >= 0 is a switch inside the step: the region is swapped in (a crossing) from an element boundary
+// chosen from the estimated switch time, and the system with that boundary's length free is
+// solved. If no consistent active set is found within
 // kMaxTries square systems, solve() returns false and the integrator uses the homotopy.
 #pragma once
 #include <vector>

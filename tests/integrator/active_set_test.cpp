@@ -123,6 +123,23 @@ TEST(ActiveSetOscillator, ProblemFileKeyAndOverride) {
   EXPECT_NEAR(r.switches[0].t, 1.0, 1e-6);
 }
 
+// Example 3(b) (examples/sliding.toml, x' in -sign(x), x0 = 0.5): the step that enters the sliding
+// mode at t = 0.5 is not a crossing; the active-set path finds no consistent active set there and
+// that one step falls back to the homotopy. Same x(T) (0) and switch time as the homotopy path.
+TEST(ActiveSetSliding, EntryFallsBackToTheHomotopyOnce) {
+  fesd::SimulationProblem q =
+      fesd::load_simulation_problem(FESD_SOURCE_DIR "/examples/sliding.toml");
+  Both b;
+  b.homotopy = fesd::integrate(q.model, q.x0, q.T_sim, q.N_sim, q.options, q.u, q.p);
+  fesd::apply_override(q, "step_solver", "active_set");
+  b.active = fesd::integrate(q.model, q.x0, q.T_sim, q.N_sim, q.options, q.u, q.p);
+  expect_same(b, 1e-9);
+  ASSERT_EQ(b.active.switches.size(), 1u);
+  EXPECT_NEAR(b.active.switches[0].t, 0.5, 1e-9);
+  EXPECT_EQ(b.active.summary.homotopy_path_steps, 1);
+  EXPECT_EQ(b.active.summary.active_set_path_steps, q.N_sim - 1);
+}
+
 TEST(ActiveSetOptions, UnknownValueIsAClearError) {
   fesd::SimulationProblem q =
       fesd::load_simulation_problem(FESD_SOURCE_DIR "/examples/oscillator.toml");
