@@ -76,6 +76,21 @@ struct Summary {
   /// has more than N_sim * N_FE elements.
   int split_steps = 0;
 
+  // ---- which path solved each step (IntegratorOptions::step_solver; docs/active-set.md) ----
+  /// Steps solved by Newton's method on the square system of their (predicted or switched)
+  /// active set, without IPOPT (step_solver = active_set).
+  int active_set_path_steps = 0;
+  /// Steps solved by the homotopy: every step with step_solver = homotopy, the fallbacks (no
+  /// consistent active set found) with active_set.
+  int homotopy_path_steps = 0;
+  /// Newton iterations of the active-set path, failed tries included.
+  int newton_iterations = 0;
+  /// Square systems solved (or tried) by the active-set path: 1 per step without a switch,
+  /// more where a switch is located.
+  int active_set_tries = 0;
+  /// Time in the active-set path (failed tries included).
+  double active_set_s = 0;
+
   // ---- the re-solve with the active set fixed (HomotopyOptions::fix_active_set) ----
   /// Successful re-solves of a step's (the OCP's) last NLP with every element's active set fixed:
   /// complementarity then holds exactly, not to complementarity_tol.

@@ -153,6 +153,14 @@ std::string no_estimate_needs_N_sim(const T& t, double error_estimate) {
   return "needs N_sim and no tol_sim (N_sim is otherwise chosen from error estimates)";
 }
 
+/// Thm 15's square system has the element lengths as unknowns: FESD only.
+std::string active_set_needs_fesd(const T& t, double solver) {
+  if (static_cast<StepSolver>(static_cast<int>(solver)) != StepSolver::ActiveSet ||
+      t.discretization == nullptr || t.discretization->use_fesd)
+    return {};
+  return "needs use_fesd = true (the standard method has no switch detection; use homotopy)";
+}
+
 std::string ell_1_needs_terminal_constraints(const T& t, double mode) {
   if (static_cast<TerminalConstraint>(static_cast<int>(mode)) != TerminalConstraint::L1 ||
       t.ocp->n_g_terminal > 0)
@@ -194,6 +202,10 @@ std::vector<Option> build() {
            kSim, "error_estimate", Use::Simulation,
            "with N_sim given, estimate the error from two companion runs (false: one run)", ""),
        [](Option& x) { x.rule = no_estimate_needs_N_sim; });
+  with(scalar<&T::step_solver>(
+           kSim, "step_solver", Use::Simulation,
+           "per step: the MPCC homotopy (IPOPT), or Newton on the active set's square system", ""),
+       [](Option& x) { x.rule = active_set_needs_fesd; });
   o.push_back(input(kSim, "u", Use::Simulation,
                     "constant control values, one per control (comma-separated)", "", true));
   o.push_back(input(kSim, "t0", Use::Simulation,
@@ -394,7 +406,8 @@ OptionTarget target_of(const NlpOptions& o) {
 OptionTarget target_of(const IntegratorOptions& o) {
   return {.discretization = const_cast<DiscretizationOptions*>(&o.discretization),
           .homotopy = const_cast<HomotopyOptions*>(&o.homotopy),
-          .nlp = const_cast<NlpOptions*>(&o.nlp)};
+          .nlp = const_cast<NlpOptions*>(&o.nlp),
+          .step_solver = const_cast<StepSolver*>(&o.step_solver)};
 }
 OptionTarget target_of(const OcpOptions& o) {
   return {.discretization = const_cast<DiscretizationOptions*>(&o.discretization),

@@ -47,7 +47,8 @@ struct OptionTarget {
   int* N_sim = nullptr;
   double* tol_sim = nullptr;  ///< simulate()'s accuracy target (AccuracyOptions)
   int* N_sim_max = nullptr;
-  bool* error_estimate = nullptr;  ///< simulate()'s companion runs (AccuracyOptions)
+  bool* error_estimate = nullptr;     ///< simulate()'s companion runs (AccuracyOptions)
+  StepSolver* step_solver = nullptr;  ///< IntegratorOptions::step_solver
   Ocp* ocp = nullptr;                 ///< [ocp] keys stored in the problem
   OcpOptions* ocp_options = nullptr;  ///< [ocp] keys stored in the solver options
 };
@@ -115,6 +116,8 @@ template <>
 std::span<const std::string_view> enum_names<OcpInitialization>();
 template <>
 std::span<const std::string_view> enum_names<KktSolver>();
+template <>
+std::span<const std::string_view> enum_names<StepSolver>();
 
 /// Every option, table by table.
 std::span<const Option> all();

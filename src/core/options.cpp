@@ -29,6 +29,7 @@ constexpr std::array<std::string_view, 5> kMpccMode{
 constexpr std::array<std::string_view, 2> kTerminalConstraint{"none", "ell_1"};
 constexpr std::array<std::string_view, 2> kOcpInitialization{"constant", "simulation"};
 constexpr std::array<std::string_view, 4> kKktSolver{"auto", "sparse_ldl", "dense", "mumps"};
+constexpr std::array<std::string_view, 2> kStepSolver{"homotopy", "active_set"};
 
 template <class E, std::size_t K>
 std::string_view name_of(const std::array<std::string_view, K>& names, E v) {
@@ -85,6 +86,10 @@ std::span<const std::string_view> enum_names<OcpInitialization>() {
 template <>
 std::span<const std::string_view> enum_names<KktSolver>() {
   return kKktSolver;
+}
+template <>
+std::span<const std::string_view> enum_names<StepSolver>() {
+  return kStepSolver;
 }
 }  // namespace registry
 
@@ -145,6 +150,12 @@ std::string_view to_string(KktSolver v) {
 }
 bool parse(std::string_view name, KktSolver& out) {
   return parse_from(kKktSolver, name, out);
+}
+std::string_view to_string(StepSolver v) {
+  return name_of(kStepSolver, v);
+}
+bool parse(std::string_view name, StepSolver& out) {
+  return parse_from(kStepSolver, name, out);
 }
 
 std::vector<std::string> validate(const DiscretizationOptions& o) {
@@ -209,7 +220,10 @@ std::vector<std::string> validate(const DiscretizationOptions& d, const Homotopy
 }
 
 std::vector<std::string> validate(const IntegratorOptions& o) {
-  return validate(o.discretization, o.homotopy, o.nlp);
+  std::vector<std::string> e = validate(o.discretization, o.homotopy, o.nlp);
+  for (auto& s : registry::check(registry::Table::Simulation, registry::target_of(o)))
+    e.push_back(std::move(s));
+  return e;
 }
 
 void check(const IntegratorOptions& o) {

@@ -55,6 +55,11 @@ std::string format_work(const Summary& s, double per_step) {
   out +=
       fmt::format("  IPOPT iterations     {}{}\n", s.nlp_iterations, per(s.nlp_iterations, "step"));
   out += fmt::format("  max comp. residual   {:.2e}\n", s.max_comp_residual);
+  if (s.active_set_path_steps > 0)
+    out += fmt::format(
+        "  active-set steps     {}  ({} by the homotopy; {} Newton iterations{}, {:.3f} s)\n",
+        s.active_set_path_steps, s.homotopy_path_steps, s.newton_iterations,
+        per(s.newton_iterations, "step"), s.active_set_s);
   if (s.fallback_steps > 0)
     out += fmt::format("  retried steps        {}  (sparse cross complementarity (28))\n",
                        s.fallback_steps);

@@ -19,6 +19,7 @@
 #include "dcs/stewart.hpp"
 #include "discretization/fesd_interval.hpp"
 #include "fesd/error.hpp"
+#include "integrator/active_set.hpp"
 #include "mpcc/problem.hpp"
 #include "nlp/nlp_solver.hpp"
 
@@ -34,12 +35,6 @@ void check_finite(const Eigen::VectorXd& v, const char* name) {
   for (Eigen::Index i = 0; i < v.size(); ++i)
     if (!std::isfinite(v[i]))
       throw InvalidModel(fmt::format("{}[{}] = {}: must be finite", name, i, v[i]));
-}
-
-std::vector<int> range_of(int first, int n) {
-  std::vector<int> v;
-  for (int i = 0; i < n; ++i) v.push_back(first + i);
-  return v;
 }
 
 Eigen::VectorXd gather(const std::vector<double>& w, int first, int n) {
@@ -89,26 +84,7 @@ std::unique_ptr<StepProblem> build_step_problem(const Pss& model, const Tableau&
                                                 const Eigen::VectorXd& p) {
   auto s = std::make_unique<StepProblem>();
   nlp::BlockNlp& nlp = s->mpcc.nlp();
-  const int n_th = model.n_theta(), n_sys = model.n_sys();
-  s->in.s0 = range_of(nlp.add_variables(model.n_x(), 0.0, 0.0, 0.0), model.n_x());
-  s->in.q = range_of(nlp.add_variables(model.n_u(), 0.0, 0.0, 0.0), model.n_u());
-  s->in.p = range_of(nlp.add_variables(model.n_p(), 0.0, 0.0, 0.0), model.n_p());
-  // FESD: lambda_{0,0}, mu_{0,0} are variables tied to s0 by the LP equation (9), not fixed
-  // numbers, so that a step starting on a switching surface (c(s0) = O(1e-13)) is not made
-  // infeasible by the round-off sign of a fixed lambda_{0,0}. The standard method does not use
-  // them (no cross complementarity): fixed.
-  if (d.use_fesd) {
-    s->in.lambda_start = range_of(nlp.add_variables(n_th, 0.0, nlp::kInf, 0.0), n_th);
-    s->in.mu_start = range_of(nlp.add_variables(n_sys, -nlp::kInf, nlp::kInf, 0.0), n_sys);
-    s->in.lp_at_start = true;
-  } else {
-    s->in.lambda_start = range_of(nlp.add_variables(n_th, 0.0, 0.0, 0.0), n_th);
-    s->in.mu_start = range_of(nlp.add_variables(n_sys, 0.0, 0.0, 0.0), n_sys);
-  }
-  s->in.T = T_step;
-  // Non-stiffly-accurate schemes: boundary values (33) at the step end too, so that a switch
-  // cannot hide between the last stage and the end of the step.
-  s->in.boundary_at_end = true;
+  s->in = integrator::add_step_inputs(nlp, model, d.use_fesd, T_step);
   s->iv = std::make_unique<discretization::FesdInterval>(model, tab, d);
   s->iv->build(nlp, s->in);
   s->mpcc.add_complementarity(s->iv->groups(), s->iv->residual_pairs());
@@ -162,6 +138,8 @@ class Integrator {
     // Initial guess of the first step: the LP at x0 (then the last stage of the step before).
     guess_ = dcs::solve_lp(model_, x0, p_);
     guess_xdot_ = xdot_at(x0, guess_.theta);
+    if (options.step_solver == StepSolver::ActiveSet)
+      active_ = std::make_unique<integrator::ActiveSetStep>(model_, tab_, d_, T_step_, u_, p_);
     StepProblem& first = level(0, 0);
     first.mpcc.finalize();
     res_.summary.n_variables = first.mpcc.num_variables();
@@ -175,7 +153,11 @@ class Integrator {
   /// Step `step` (0-based) of N_sim: advances over it with the retry policy, reports progress.
   bool step(int step) {
     careful_ = false;
-    const bool ok = advance(0);
+    bool ok = active_ && active_set_step();
+    if (!ok) {
+      ++res_.summary.homotopy_path_steps;
+      ok = advance(0);
+    }
     if (options_.on_step)
       options_.on_step({step + 1, N_sim_, t_, static_cast<int>(last_.rows.size()),
                         last_.nlp_iterations, last_.comp_residual, last_.status});
@@ -193,6 +175,44 @@ class Integrator {
   }
 
  private:
+  // ---- the active-set path (step_solver = active_set; docs/active-set.md) ----
+
+  /// The step by Newton's method on the square system of the active set predicted from the end
+  /// of the step before (the LP at x0 for the first), with a crossing located where the signs
+  /// fail. False: no consistent active set found, the homotopy takes the step.
+  bool active_set_step() {
+    const auto t0 = Clock::now();
+    integrator::ActiveSetStep& as = *active_;
+    const std::vector<int> predicted =
+        res_.active_set.empty() ? lp_active_set(guess_) : res_.active_set.back();
+    const bool ok = as.solve(x_, predicted, guess_, guess_xdot_);
+    Summary& sum = res_.summary;
+    sum.newton_iterations += as.newton_iterations();
+    sum.active_set_tries += as.tries();
+    sum.active_set_s += seconds_since(t0);
+    if (!ok) return false;
+    ++sum.active_set_path_steps;
+    const std::vector<double>& w = as.solution();
+    last_ = {};
+    last_.status = Status::Success;
+    last_.active_set_fixed = true;
+    last_.comp_residual = mpcc::comp_residual(w.data(), as.interval().residual_pairs());
+    res_.homotopy.emplace_back();  // no NLPs: the step's homotopy table is empty
+    commit(as.interval(), w, last_.comp_residual, {});
+    return true;
+  }
+
+  /// The active regions of the LP solution at the start (theta above lambda and 1e-6), the
+  /// stage-wise rule of FesdInterval::active_set().
+  std::vector<int> lp_active_set(const dcs::LpSolution& lp) const {
+    std::vector<int> a;
+    for (int r = 0; r < model_.n_theta(); ++r)
+      if (lp.theta[r] >
+          std::max(std::abs(lp.lambda[r]), discretization::FesdInterval::kActiveThetaTol))
+        a.push_back(r);
+    return a;
+  }
+
   // ---- the retry policy ----
 
   /// Advances over one step of level k (length T_step / 2^k): N_FE elements; where that fails
@@ -254,17 +274,24 @@ class Integrator {
       failed_ = solved;
       return false;
     }
-    res_.summary.max_comp_residual = std::max(res_.summary.max_comp_residual, hr.comp_residual);
+    commit(*solved->iv, solved->mpcc.solution(), hr.comp_residual, unlocated);
+    return true;
+  }
+
+  /// Appends a solved step (NLP point w of the interval iv) to the result, with its held
+  /// switches and the exits whose pin failed.
+  void commit(const discretization::FesdInterval& iv, const std::vector<double>& w,
+              double comp_residual, const std::vector<int>& unlocated) {
+    res_.summary.max_comp_residual = std::max(res_.summary.max_comp_residual, comp_residual);
     const std::size_t first_switch = res_.switches.size();
     const double t_step = t_;
-    report_held_switches(*solved, t_step);
-    accept(*solved);
+    report_held_switches(iv, w, t_step);
+    accept(iv, w);
     // An exit at the end of the step before, whose pin failed there, is recorded here (the switch
     // at a step boundary belongs to the step that starts at it).
     if (!carried_unlocated_.empty()) mark_switches(first_switch, carried_unlocated_);
     carried_unlocated_ = unlocated;
     if (!unlocated.empty()) mark_unlocated(first_switch, t_step, unlocated);
-    return true;
   }
 
   /// A homotopy whose NLPs converged but whose complementarity residual stayed above
@@ -366,8 +393,9 @@ class Integrator {
   /// Switches of the accepted step held by the grid (FesdInterval::held_switches, as in the OCP):
   /// a neighbouring segment has every element length at a bound (1 +- gamma_h) h, so the switch
   /// may have been stopped short of its time. Counted and named in a warning, never silent.
-  void report_held_switches(const StepProblem& sp, double t_step) {
-    for (double t : sp.iv->held_switch_times(sp.mpcc.solution().data(), t_step)) {
+  void report_held_switches(const discretization::FesdInterval& iv, const std::vector<double>& w,
+                            double t_step) {
+    for (double t : iv.held_switch_times(w.data(), t_step)) {
       ++res_.summary.held_switches;
       res_.summary.warnings.push_back(fmt::format(
           "the switch at t = {:.6g} is held by the grid: the element lengths next to it are at "
@@ -485,9 +513,7 @@ class Integrator {
   }
 
   /// Appends the solved step to the result; its end state and last stage start the next step.
-  void accept(const StepProblem& sp) {
-    const discretization::FesdInterval& iv = *sp.iv;
-    const std::vector<double>& w = sp.mpcc.solution();
+  void accept(const discretization::FesdInterval& iv, const std::vector<double>& w) {
     append_step(res_, model_, iv, tab_, w, t_);
     x_ = res_.x.back();
     const int last = iv.N_FE() - 1, n_s = d_.n_s;
@@ -539,7 +565,8 @@ class Integrator {
   const Eigen::VectorXd u_, p_;
   std::vector<std::array<Level, 2>> levels_;
   std::unique_ptr<nlp::NlpSolver> solver_;
-  std::unique_ptr<nlp::NlpSolver> mumps_;  // the retries' solver with kkt_solver = auto
+  std::unique_ptr<nlp::NlpSolver> mumps_;              // the retries' solver with kkt_solver = auto
+  std::unique_ptr<integrator::ActiveSetStep> active_;  // step_solver = active_set
 
   /// The NLP solver of the current attempt: once an attempt of the step has failed (careful_),
   /// and kkt_solver is auto, its retries factor the KKT systems with MUMPS, the fallback of the

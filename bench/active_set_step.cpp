@@ -1,0 +1,203 @@
+// bench/active_set_step.cpp: the two step solvers side by side (issue 15 item 3, first number;
+// docs/active-set.md, docs/benchmarks.md "Active-set step solver").
+//
+// The oscillator (47) of papers/fesd-filippov.txt, Radau IIA n_s = 3, N_FE = 2, T = pi/2, and
+// Example 3(a) (x' in 2 - sign(x), x0 = -1, T = 1.9), integrated with step_solver = homotopy and
+// step_solver = active_set in one process: per path the median over R repetitions of the time of
+// integrate() (in-process wall time and this process's CPU time), per step, the Newton iterations
+// and the IPOPT iterations per step, the steps each path solved, the error of x(T) against the
+// exact value and of the switch time.
+//
+//   active_set_step [--N 40] [--repeat R] [--repeat-active RA] [--csv FILE] [--json FILE]
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <fesd/integrator.hpp>
+#include <fesd/options.hpp>
+
+#include "bench_args.hpp"
+#include "oscillator_model.hpp"
+#include "sensitivity_ocp.hpp"
+
+namespace fesd_bench {
+[[noreturn]] void usage(const std::string& why, int exit_code) {
+  std::fprintf(stderr,
+               "active_set_step: %s\nusage: active_set_step [--N 40] [--repeat R] "
+               "[--repeat-active RA] [--csv FILE] [--json FILE]\n",
+               why.c_str());
+  std::exit(exit_code);
+}
+}  // namespace fesd_bench
+
+namespace {
+
+struct Case {
+  std::string name;
+  fesd::Pss model;
+  Eigen::VectorXd x0, x_exact;
+  double T = 0, t_s = 0;
+  int n_s = 3;
+};
+
+struct Row {
+  std::string problem, path;
+  int N_sim = 0, repeats = 0;
+  double wall_s = 0, cpu_s = 0;    // medians per run
+  double path_s = 0, setup_s = 0;  // of the last run: time in the active-set path, setup
+  double newton_per_step = 0, ipopt_per_step = 0, nlps_per_step = 0;
+  int active_set_steps = 0, homotopy_steps = 0, tries = 0;
+  double error_x = 0, error_t_s = 0;
+};
+
+double cpu_now() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+Row measure(const Case& c, int N_sim, fesd::StepSolver solver, int repeats) {
+  fesd::IntegratorOptions o;
+  o.discretization.rk_scheme = fesd::RkScheme::RadauIIA;
+  o.discretization.n_s = c.n_s;
+  o.discretization.N_FE = 2;
+  o.step_solver = solver;
+  std::vector<double> wall, cpu;
+  fesd::IntegratorResult r;
+  for (int k = 0; k < repeats; ++k) {
+    const double c0 = cpu_now();
+    const auto t0 = std::chrono::steady_clock::now();
+    r = fesd::integrate(c.model, c.x0, c.T, N_sim, o);
+    wall.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    cpu.push_back(cpu_now() - c0);
+  }
+  Row row;
+  row.problem = c.name;
+  row.path = std::string(fesd::to_string(solver));
+  row.N_sim = N_sim;
+  row.repeats = repeats;
+  row.wall_s = median(wall);
+  row.cpu_s = median(cpu);
+  const fesd::Summary& s = r.summary;
+  row.path_s = s.active_set_s;
+  row.setup_s = s.setup_s;
+  row.newton_per_step = static_cast<double>(s.newton_iterations) / N_sim;
+  row.ipopt_per_step = static_cast<double>(s.nlp_iterations) / N_sim;
+  row.nlps_per_step = static_cast<double>(s.homotopy_steps) / N_sim;
+  row.active_set_steps = s.active_set_path_steps;
+  row.homotopy_steps = s.homotopy_path_steps;
+  row.tries = s.active_set_tries;
+  row.error_x = r.status == fesd::Status::Success ? (r.x_final() - c.x_exact).norm() : NAN;
+  row.error_t_s = r.switches.size() == 1 ? std::abs(r.switches[0].t - c.t_s) : NAN;
+  return row;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using fesd_bench::parse_int;
+  int N_sim = 40, repeat = 3, repeat_active = 200;
+  std::string csv, json_path;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (i + 1 >= argc) fesd_bench::usage(a + ": missing value");
+    const std::string v = argv[++i];
+    if (a == "--N")
+      N_sim = parse_int(a, v);
+    else if (a == "--repeat")
+      repeat = parse_int(a, v);
+    else if (a == "--repeat-active")
+      repeat_active = parse_int(a, v);
+    else if (a == "--csv")
+      csv = v;
+    else if (a == "--json")
+      json_path = v;
+    else
+      fesd_bench::usage("unknown argument " + a);
+  }
+
+  std::vector<Case> cases;
+  cases.push_back({"oscillator (47)", fesd_bench::oscillator_model(), fesd_bench::oscillator_x0(),
+                   fesd_bench::oscillator_exact_xT(), fesd_bench::kOscillatorT,
+                   fesd_bench::kOscillatorSwitch, 3});
+  cases.push_back(
+      {"Example 3(a)",
+       fesd::make_pss(fesd_bench::SensitivityModel{},
+                      fesd::PssDims{.n_x = 1, .subsystems = {fesd::Subsystem::from_c(1)}}),
+       Eigen::VectorXd::Constant(1, -1.0), Eigen::VectorXd::Constant(1, 1.9 - 1.0 / 3.0), 1.9,
+       1.0 / 3.0, 3});
+
+  std::vector<Row> rows;
+  for (const Case& c : cases) {
+    rows.push_back(measure(c, N_sim, fesd::StepSolver::Homotopy, repeat));
+    rows.push_back(measure(c, N_sim, fesd::StepSolver::ActiveSet, repeat_active));
+  }
+
+  fmt::print("Radau IIA n_s = 3, N_FE = 2, N_sim = {}; medians over the repetitions (in-process)\n",
+             N_sim);
+  fmt::print(
+      "{:<16} {:<11} {:>5} {:>10} {:>10} {:>10} {:>10} {:>9} {:>7} {:>7} {:>6} {:>9} {:>9} {:>9} "
+      "{:>9}\n",
+      "problem", "path", "reps", "wall ms", "cpu ms", "us/step", "path wall", "setup ms", "Newton",
+      "IPOPT", "NLPs", "as/hom", "err x(T)", "err t_s", "speedup");
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const Row& r = rows[i];
+    const Row& base = rows[i - i % 2];
+    fmt::print(
+        "{:<16} {:<11} {:>5} {:>10.3f} {:>10.3f} {:>10.1f} {:>10.1f} {:>9.3f} {:>7.2f} {:>7.1f} "
+        "{:>6.2f} {:>9} {:>9.1e} {:>9.1e} {:>8.0f}x\n",
+        r.problem, r.path, r.repeats, 1e3 * r.wall_s, 1e3 * r.cpu_s, 1e6 * r.cpu_s / r.N_sim,
+        1e6 * r.path_s / r.N_sim, 1e3 * r.setup_s, r.newton_per_step, r.ipopt_per_step,
+        r.nlps_per_step, fmt::format("{}/{}", r.active_set_steps, r.homotopy_steps), r.error_x,
+        r.error_t_s, base.cpu_s / r.cpu_s);
+  }
+  if (!csv.empty()) {
+    std::ofstream f(csv);
+    f << "problem,path,N_sim,repeats,wall_s,cpu_s,cpu_s_per_step,newton_per_step,"
+         "ipopt_per_step,nlps_per_step,active_set_steps,homotopy_steps,tries,error_x,error_t_s,"
+         "path_s,setup_s\n";
+    for (const Row& r : rows)
+      f << fmt::format(
+          "{},{},{},{},{:.6e},{:.6e},{:.6e},{:.3f},{:.3f},{:.3f},{},{},{},{:.3e},{:.3e},{:.6e},"
+          "{:.6e}\n",
+          r.problem, r.path, r.N_sim, r.repeats, r.wall_s, r.cpu_s, r.cpu_s / r.N_sim,
+          r.newton_per_step, r.ipopt_per_step, r.nlps_per_step, r.active_set_steps,
+          r.homotopy_steps, r.tries, r.error_x, r.error_t_s, r.path_s, r.setup_s);
+  }
+  if (!json_path.empty()) {
+    nlohmann::json j = nlohmann::json::array();
+    for (const Row& r : rows)
+      j.push_back({{"problem", r.problem},
+                   {"path", r.path},
+                   {"N_sim", r.N_sim},
+                   {"repeats", r.repeats},
+                   {"wall_s", r.wall_s},
+                   {"cpu_s", r.cpu_s},
+                   {"cpu_s_per_step", r.cpu_s / r.N_sim},
+                   {"newton_per_step", r.newton_per_step},
+                   {"ipopt_per_step", r.ipopt_per_step},
+                   {"nlps_per_step", r.nlps_per_step},
+                   {"active_set_steps", r.active_set_steps},
+                   {"homotopy_steps", r.homotopy_steps},
+                   {"tries", r.tries},
+                   {"error_x", r.error_x},
+                   {"error_t_s", r.error_t_s},
+                   {"path_s", r.path_s},
+                   {"setup_s", r.setup_s}});
+    std::ofstream(json_path) << j.dump(2) << "\n";
+  }
+  return 0;
+}

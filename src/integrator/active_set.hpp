@@ -1,0 +1,112 @@
+// src/integrator/active_set.hpp: the active-set step of the integrator (docs/active-set.md).
+//
+// Thm 15 of papers/fesd-filippov.txt: with the active set of every finite element fixed (theta = 0
+// off it, lambda = 0 on it at every lambda point of the element), the FESD equations (32) of one
+// integration step are a square nonlinear system in the stage values, the free lambda, mu and the
+// element lengths h_n:
+//
+//   the equations of FesdInterval (stage states, dynamics (25), LP (9), simplex, sum h_n = T),
+//   h_n - h_{n-1} = 0 at every interior boundary where the active set does not change (what step
+//   equilibration (31) imposes there), and at a boundary where it changes the switch condition
+//   instead: both regions have lambda = 0 at that point (cross complementarity), i.e. c(x) = 0.
+//
+// ActiveSetStep solves it by Newton's method with the exact Jacobian (forward AD of the blocks,
+// a dense LU of Eigen), for the active set predicted from the previous step's end, then checks the
+// signs (theta >= 0 on, lambda >= 0 off the active set, h_n within its bounds). A violated lambda
+// >= 0 is a switch inside the step: the region is swapped in (a crossing) from an element boundary
+// chosen from the estimated switch time, and the system with that boundary's length free is
+// solved. If no consistent active set is found within
+// kMaxTries square systems, solve() returns false and the integrator uses the homotopy.
+#pragma once
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "dcs/stewart.hpp"
+#include "discretization/fesd_interval.hpp"
+#include "fesd/model.hpp"
+#include "fesd/options.hpp"
+#include "fesd/tableau.hpp"
+#include "nlp/block_nlp.hpp"
+
+namespace fesd::integrator {
+
+/// The input variables of one integration step in `nlp`: s0, q, p (fixed by their bounds by the
+/// caller), and for FESD lambda_{0,0}, mu_{0,0} tied to s0 by the LP (9) (lp_at_start); boundary
+/// values at the step end (boundary_at_end). Shared by the homotopy's and the active-set path's
+/// step problems.
+discretization::IntervalInputs add_step_inputs(nlp::BlockNlp& nlp, const Pss& model, bool use_fesd,
+                                               double T_step);
+
+/// One Newton solve (or a failed try) of the active-set path.
+struct ActiveSetTry {
+  bool converged = false;
+  int iterations = 0;
+};
+
+class ActiveSetStep {
+ public:
+  /// A step of length T_step with d.N_FE elements; d must be FESD.
+  ActiveSetStep(const Pss& model, const Tableau& tab, const DiscretizationOptions& d, double T_step,
+                const Eigen::VectorXd& u, const Eigen::VectorXd& p);
+
+  /// Solves the step from x0 with every element starting in the active set `predicted` (sorted
+  /// region indices), the guess from `lp` (algebraic values) and `xdot`. True when a consistent
+  /// active set was found; then solution() is the step (layout interval()).
+  bool solve(const Eigen::VectorXd& x0, const std::vector<int>& predicted,
+             const dcs::LpSolution& lp, const Eigen::VectorXd& xdot);
+
+  const discretization::FesdInterval& interval() const { return *iv_; }
+  const std::vector<double>& solution() const { return w_; }
+  /// Of the last solve(): Newton iterations and square systems tried (all tries).
+  int newton_iterations() const { return iterations_; }
+  int tries() const { return tries_; }
+  /// Size of the square system (per active-set shape; the last one solved).
+  int system_size() const { return static_cast<int>(free_.size()); }
+
+  /// Square systems tried per step before the homotopy takes over.
+  static constexpr int kMaxTries = 4;
+  static constexpr int kMaxNewton = 25;
+  /// Sign tolerance of theta >= 0, lambda >= 0 (a switch within ~kSignTol / |c'| of a step end
+  /// is taken at the step end).
+  static constexpr double kSignTol = 1e-9;
+
+ private:
+  using Sets = std::vector<std::vector<int>>;
+  /// Newton's method from w_ with the active sets `active`; w_ is the result.
+  ActiveSetTry newton(const Sets& active);
+  /// The first violated lambda >= 0 (region r at time t_bad, the last time t_ok where it held),
+  /// or r = -1 if the signs hold; `bad` is set when a sign fails that no switch can repair
+  /// (theta < 0, h_n out of bounds).
+  struct Violation {
+    int r = -1;
+    double t_ok = 0, t_bad = 0, lam_ok = 0, lam_bad = 0;
+    bool bad = false;
+  };
+  Violation check_signs(const Sets& active) const;
+  /// Boundaries b (0..N_FE-1) where a switch at time ts can sit with every h_n within its bounds,
+  /// best first (the least sum (h_n - T/N_FE)^2, the homotopy's heuristic_mean choice).
+  std::vector<int> boundaries_for(double ts) const;
+  /// Guess of the switched system: elements from b on with `after` instead of `before`, element
+  /// lengths ts / b and (T - ts) / (N_FE - b), from the converged prediction w_pred.
+  void switched_guess(const std::vector<double>& w_pred, const std::vector<int>& before,
+                      const std::vector<int>& after, int b, double ts);
+
+  const Pss& model_;
+  Tableau tab_;
+  DiscretizationOptions d_;
+  double T_;
+  nlp::BlockNlp nlp_;
+  discretization::IntervalInputs in_;
+  std::unique_ptr<discretization::FesdInterval> iv_;
+  std::vector<double> w_;
+  // per square system: the free variables (column map), bounds with the active set applied
+  std::vector<int> free_, col_of_;
+  std::vector<double> lb_, ub_;
+  Eigen::MatrixXd J_;
+  Eigen::VectorXd F_, dz_;
+  std::vector<double> g_, jac_;
+  int iterations_ = 0, tries_ = 0;
+};
+
+}  // namespace fesd::integrator

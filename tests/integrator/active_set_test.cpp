@@ -1,0 +1,186 @@
+// step_solver = active_set (docs/active-set.md): Newton's method on the square system of Thm 15
+// gives the same x(T) and switch times as the homotopy path, with every step (or all but a counted
+// few) solved without IPOPT. Exact values from REFERENCE.md.
+#include <cmath>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "../../bench/oscillator_model.hpp"
+#include "../../bench/sensitivity_ocp.hpp"
+#include "fesd/error.hpp"
+#include "fesd/integrator.hpp"
+#include "fesd/model.hpp"
+#include "fesd/problem_file.hpp"
+
+namespace {
+
+using fesd::IntegratorOptions;
+using fesd::IntegratorResult;
+using fesd::RkScheme;
+using fesd::StepSolver;
+
+// Example 3(a): x' in 2 - sign(x), the model of the sensitivity OCP (56)
+// (bench/sensitivity_ocp.hpp): region 0 is x > 0 (x' = 1), region 1 is x < 0 (x' = 3).
+fesd::Pss crossing_model() {
+  return fesd::make_pss(fesd_bench::SensitivityModel{},
+                        fesd::PssDims{.n_x = 1, .subsystems = {fesd::Subsystem::from_c(1)}});
+}
+
+IntegratorOptions options(RkScheme scheme, int n_s, StepSolver solver) {
+  IntegratorOptions o;
+  o.discretization.rk_scheme = scheme;
+  o.discretization.n_s = n_s;
+  o.step_solver = solver;
+  return o;
+}
+
+/// Both paths on one problem: same switches (times to tol), same x(T) (to tol).
+struct Both {
+  IntegratorResult homotopy, active;
+};
+Both run_both(const fesd::Pss& model, const Eigen::VectorXd& x0, double T, int N_sim,
+              IntegratorOptions o) {
+  Both b;
+  o.step_solver = StepSolver::Homotopy;
+  b.homotopy = fesd::integrate(model, x0, T, N_sim, o);
+  o.step_solver = StepSolver::ActiveSet;
+  b.active = fesd::integrate(model, x0, T, N_sim, o);
+  return b;
+}
+
+void expect_same(const Both& b, double tol) {
+  ASSERT_EQ(b.homotopy.status, fesd::Status::Success) << b.homotopy.message;
+  ASSERT_EQ(b.active.status, fesd::Status::Success) << b.active.message;
+  ASSERT_EQ(b.active.switches.size(), b.homotopy.switches.size());
+  for (std::size_t i = 0; i < b.active.switches.size(); ++i) {
+    EXPECT_NEAR(b.active.switches[i].t, b.homotopy.switches[i].t, tol) << "switch " << i;
+    EXPECT_EQ(b.active.switches[i].before, b.homotopy.switches[i].before);
+    EXPECT_EQ(b.active.switches[i].after, b.homotopy.switches[i].after);
+  }
+  EXPECT_LT((b.active.x_final() - b.homotopy.x_final()).lpNorm<Eigen::Infinity>(), tol);
+}
+
+// Example 3(a), x0 = -1: switch at t_s = 1/3, x(T) = T - 1/3 (REFERENCE.md). Piecewise linear,
+// so both paths are exact up to their solver tolerances: 1e-9. Every step on the active-set path,
+// no NLP solved at all.
+class ActiveSetCrossing : public ::testing::TestWithParam<std::pair<RkScheme, int>> {};
+TEST_P(ActiveSetCrossing, SameAsHomotopyAndExact) {
+  const auto [scheme, n_s] = GetParam();
+  const double T = 1.9;
+  const int N_sim = 7;
+  const Eigen::VectorXd x0 = Eigen::VectorXd::Constant(1, -1.0);
+  const Both b =
+      run_both(crossing_model(), x0, T, N_sim, options(scheme, n_s, StepSolver::Homotopy));
+  expect_same(b, 1e-9);
+  ASSERT_EQ(b.active.switches.size(), 1u);
+  EXPECT_NEAR(b.active.switches[0].t, 1.0 / 3.0, 1e-9);
+  EXPECT_NEAR(b.active.x_final()[0], T - 1.0 / 3.0, 1e-9);
+  const fesd::Summary& s = b.active.summary;
+  EXPECT_EQ(s.active_set_path_steps, N_sim);
+  EXPECT_EQ(s.homotopy_path_steps, 0);
+  EXPECT_EQ(s.homotopy_steps, 0);  // no NLP
+  EXPECT_EQ(b.homotopy.summary.homotopy_path_steps, N_sim);
+  EXPECT_EQ(b.homotopy.summary.active_set_path_steps, 0);
+  // One square system per step, two more in the step with the switch (prediction, then the
+  // crossing at boundary 1).
+  EXPECT_EQ(s.active_set_tries, N_sim + 1);
+}
+INSTANTIATE_TEST_SUITE_P(Schemes, ActiveSetCrossing,
+                         ::testing::Values(std::pair{RkScheme::RadauIIA, 1},
+                                           std::pair{RkScheme::RadauIIA, 2},
+                                           std::pair{RkScheme::RadauIIA, 3},
+                                           std::pair{RkScheme::GaussLegendre, 2}));
+
+// The oscillator (47), Radau IIA n_s = 3, N_FE = 2, N_sim = 40 (issue 15's case): the crossing of
+// the unit circle at t_s = 1 and x(T) agree with the homotopy path to 1e-9, every step on the
+// active-set path; the error against the exact x(T) is the scheme's (REFERENCE.md: 3.8e-7).
+TEST(ActiveSetOscillator, SameAsHomotopyRadau3) {
+  const fesd::Pss model = fesd_bench::oscillator_model();
+  const Both b = run_both(model, fesd_bench::oscillator_x0(), fesd_bench::kOscillatorT, 40,
+                          options(RkScheme::RadauIIA, 3, StepSolver::Homotopy));
+  expect_same(b, 1e-9);
+  ASSERT_EQ(b.active.switches.size(), 1u);
+  EXPECT_NEAR(b.active.switches[0].t, fesd_bench::kOscillatorSwitch, 1e-6);
+  EXPECT_LT((b.active.x_final() - fesd_bench::oscillator_exact_xT()).norm(), 1e-6);
+  EXPECT_EQ(b.active.summary.active_set_path_steps, 40);
+  EXPECT_EQ(b.active.summary.homotopy_path_steps, 0);
+  // Newton converges quadratically: at most 6 iterations per square system here.
+  EXPECT_LE(b.active.summary.newton_iterations, 6 * b.active.summary.active_set_tries);
+}
+
+// The same through the problem file and the generic override (as `--step_solver active_set`).
+TEST(ActiveSetOscillator, ProblemFileKeyAndOverride) {
+  fesd::SimulationProblem q =
+      fesd::load_simulation_problem(FESD_SOURCE_DIR "/examples/oscillator.toml");
+  EXPECT_EQ(q.options.step_solver, StepSolver::Homotopy);  // the default
+  fesd::apply_override(q, "step_solver", "active_set");
+  EXPECT_EQ(q.options.step_solver, StepSolver::ActiveSet);
+  const IntegratorResult r = fesd::integrate(q.model, q.x0, q.T_sim, 40, q.options, q.u, q.p);
+  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+  EXPECT_EQ(r.summary.active_set_path_steps, 40);
+  ASSERT_EQ(r.switches.size(), 1u);
+  EXPECT_NEAR(r.switches[0].t, 1.0, 1e-6);
+}
+
+// Example 3(b) (examples/sliding.toml, x' in -sign(x), x0 = 0.5): the step that enters the sliding
+// mode at t = 0.5 is not a crossing; the active-set path finds no consistent active set there and
+// that one step falls back to the homotopy. Same x(T) (0) and switch time as the homotopy path.
+TEST(ActiveSetSliding, EntryFallsBackToTheHomotopyOnce) {
+  fesd::SimulationProblem q =
+      fesd::load_simulation_problem(FESD_SOURCE_DIR "/examples/sliding.toml");
+  Both b;
+  b.homotopy = fesd::integrate(q.model, q.x0, q.T_sim, q.N_sim, q.options, q.u, q.p);
+  fesd::apply_override(q, "step_solver", "active_set");
+  b.active = fesd::integrate(q.model, q.x0, q.T_sim, q.N_sim, q.options, q.u, q.p);
+  expect_same(b, 1e-9);
+  ASSERT_EQ(b.active.switches.size(), 1u);
+  EXPECT_NEAR(b.active.switches[0].t, 0.5, 1e-9);
+  EXPECT_EQ(b.active.summary.homotopy_path_steps, 1);
+  EXPECT_EQ(b.active.summary.active_set_path_steps, q.N_sim - 1);
+}
+
+TEST(ActiveSetOptions, UnknownValueIsAClearError) {
+  fesd::SimulationProblem q =
+      fesd::load_simulation_problem(FESD_SOURCE_DIR "/examples/oscillator.toml");
+  try {
+    fesd::apply_override(q, "step_solver", "newton");
+    FAIL() << "expected fesd::InvalidOption";
+  } catch (const fesd::InvalidOption& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("step_solver"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("active_set"), std::string::npos) << msg;  // the valid names
+  }
+  const std::string text = R"(
+[model]
+x = ["x"]
+c = ["x"]
+F = [["1"], ["3"]]
+x0 = [-1.0]
+[simulation]
+T_sim = 1.0
+step_solver = "fast"
+)";
+  try {
+    (void)fesd::parse_simulation_problem(text, "bad.toml");
+    FAIL() << "expected an error";
+  } catch (const fesd::Error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("step_solver"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("bad.toml"), std::string::npos) << msg;
+  }
+}
+
+TEST(ActiveSetOptions, NeedsFesd) {
+  IntegratorOptions o = options(RkScheme::RadauIIA, 2, StepSolver::ActiveSet);
+  o.discretization.use_fesd = false;
+  const auto errors = fesd::validate(o);
+  ASSERT_EQ(errors.size(), 1u);
+  EXPECT_NE(errors[0].find("step_solver"), std::string::npos) << errors[0];
+  EXPECT_NE(errors[0].find("use_fesd"), std::string::npos) << errors[0];
+  EXPECT_THROW(
+      (void)fesd::integrate(crossing_model(), Eigen::VectorXd::Constant(1, -1.0), 1.0, 2, o),
+      fesd::InvalidOption);
+}
+
+}  // namespace
