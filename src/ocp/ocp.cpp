@@ -581,30 +581,29 @@ void probe_touches(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Eigen::
   }
 }
 
-/// One move of the allocation search: interval k's segment j - 1 gets `dir` elements more and
-/// segment j as many fewer (dir 0: the counts as they are), all of equal length on each segment
-/// (FesdInterval::regrid with explicit counts), and the last NLP is solved from there with every
-/// active set fixed. The re-gridded point is the old solution on each segment, so its cost (the
-/// new quadrature of the old trajectory) predicts the move: it is solved only if that cost is
+/// One move of the allocation search: interval k re-gridded with `count` elements per segment
+/// (the current counts with one moved across switch j, or as they are), equal lengths on each
+/// segment (FesdInterval::regrid with explicit counts), and the last NLP is solved from there with
+/// every active set fixed. The re-gridded point is the old solution on each segment, so its cost
+/// (the new quadrature of the old trajectory) predicts the move: it is solved only if that cost is
 /// lower, or if the regrid had to move the switch (an h bound). Kept (true) if it converges and
 /// lowers the cost.
 template <class Account>
 bool try_allocation_move(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Eigen::VectorXd& p,
                          nlp::NlpSolver& solver, const Account& account, mpcc::HomotopyResult& hr,
-                         std::size_t k, std::size_t j, int dir, Summary& summary) {
+                         std::size_t k, std::size_t j, const std::vector<int>& count,
+                         Summary& summary) {
   const FesdInterval& iv = *b.iv[k];
   const std::vector<double> w = b.mpcc.solution();
-  std::vector<int> count = iv.segment_counts(w.data());
   if (j >= count.size()) return false;
-  count[j - 1] += dir;
-  count[j] -= dir;
   std::vector<double> start = w;
   if (!iv.regrid(w.data(), start, count)) return false;
   const double cost_before = cost(b, ocp, w, p);
   const double slack = 1e-9 * std::max(1.0, std::abs(cost_before));
   auto switch_time = [&](const std::vector<double>& v) {
     double t = 0;
-    for (int n = 0; n < iv.segment_boundaries(v.data())[j]; ++n) t += v[iv.h(n)];
+    const int n_end = iv.segment_boundaries(v.data())[j];
+    for (int n = 0; n < n_end; ++n) t += v[iv.h(n)];
     return t;
   };
   const bool moved = std::abs(switch_time(w) - switch_time(start)) > 1e-9 * ocp.T;
@@ -654,7 +653,7 @@ void search_allocation(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Eig
     auto key = std::make_tuple(k, dir == 0, std::move(count));
     if (failed.contains(key)) return false;
     const int solves = summary.allocation_solves;
-    if (try_allocation_move(b, ocp, o, p, solver, account, hr, k, j, dir, summary)) {
+    if (try_allocation_move(b, ocp, o, p, solver, account, hr, k, j, std::get<2>(key), summary)) {
       ++summary.allocation_moves;
       return true;
     }
@@ -703,7 +702,9 @@ bool force_allocation(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Eige
   // first step).
   for (std::size_t k = 0; k < b.iv.size(); ++k)
     for (int n = 0;
-         n < 8 && try_allocation_move(b, ocp, o, p, solver, account, hr, k, 1, 0, summary); ++n) {
+         n < 8 && try_allocation_move(b, ocp, o, p, solver, account, hr, k, 1,
+                                      b.iv[k]->segment_counts(b.mpcc.solution().data()), summary);
+         ++n) {
     }
   return true;
 }
