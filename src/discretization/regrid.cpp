@@ -180,9 +180,13 @@ bool FesdInterval::regrid(const double* w_old, std::vector<double>& w_new,
     const double hn = w_old[h(n)];
     return lagrange(tau, y, i, hn > 0 ? (t - t_old[n]) / hn : 0.0);
   };
-  auto old_element = [&](std::size_t j, double t) {  // the old element of segment j holding t
+  // The old element of segment j holding t. Elements of length ~0 are skipped: a segment can
+  // start with one (a crossing written as {1} -> {0,1} -> {0} through a collapsed element joins
+  // the segment after it), and its theta, mixed on the surface, would make the new element's
+  // active set {0,1}; fixed, that set holds the element on the surface and collapses it again.
+  auto old_element = [&](std::size_t j, double t) {
     int n = b[j];
-    while (n + 1 < b[j + 1] && t_old[n + 1] <= t) ++n;
+    while (n + 1 < b[j + 1] && (t_old[n + 1] <= t || collapsed(w_old, n))) ++n;
     return n;
   };
 

@@ -71,6 +71,15 @@ INSTANTIATE_TEST_SUITE_P(
                                      kLobattoX0, kLobattoV},
                       AllocationCase{RkScheme::LobattoIIIC, 2, 25, OcpInitialization::Simulation,
                                      2.7, kLobattoX0, kLobattoV},
+                      // The three guesses of bench/ocp_robustness (-3 + 6 k / 29, k = 4, 5, 7)
+                      // that ended one element off (x0 = -1.4259442, -1.4266360) while the
+                      // regrid copied a collapsed element's mixed theta (docs/formulation.md).
+                      AllocationCase{RkScheme::LobattoIIIC, 2, 25, OcpInitialization::Constant,
+                                     -3.0 + 6.0 * 4 / 29, kLobattoX0, kLobattoV},
+                      AllocationCase{RkScheme::LobattoIIIC, 2, 25, OcpInitialization::Constant,
+                                     -3.0 + 6.0 * 5 / 29, kLobattoX0, kLobattoV},
+                      AllocationCase{RkScheme::LobattoIIIC, 2, 25, OcpInitialization::Constant,
+                                     -3.0 + 6.0 * 7 / 29, kLobattoX0, kLobattoV},
                       AllocationCase{RkScheme::RadauIIA, 1, 25, OcpInitialization::Simulation, -2.7,
                                      kRadau25X0, kRadau25V},
                       AllocationCase{RkScheme::RadauIIA, 1, 25, OcpInitialization::Constant, -0.9,
