@@ -137,15 +137,16 @@ struct HomotopyOptions {
   /// (docs/formulation.md): the belt's x(10) error 4e-8 -> 1e-12 and its exit time 3e-2 -> 8e-9 at
   /// N_sim = 200, for ~1 NLP (3-4 IPOPT iterations) more per step.
   bool fix_active_set = true;
-  /// `active_set_sigma` >= 0 (optimal control with FESD and a stiffly accurate scheme, Radau IIA
-  /// or Lobatto IIIC, as fix_active_set; the integrator does not use it): once an NLP of
-  /// the homotopy with sigma <= active_set_sigma has the same active set in every finite element
-  /// as the NLP before it, the rest of the homotopy is replaced by one NLP with those active sets
-  /// fixed (theta = 0 off them, lambda = 0 on them; sliding exits pinned as with
-  /// pin_sliding_exits), whose complementarity holds exactly. If that NLP fails, the homotopy
-  /// goes on, and that active set is not tried again. 0: off (every NLP down to
-  /// complementarity_tol). Measured (docs/formulation.md): 1e-3 ends OCP (61) on another branch
-  /// (cost 9.1710 instead of 9.1685); 1e-4 keeps every example's cost.
+  /// `active_set_sigma` >= 0 (FESD with a stiffly accurate scheme, Radau IIA or Lobatto IIIC, as
+  /// fix_active_set; optimal control and every integration step): once an NLP of the homotopy
+  /// with sigma <= active_set_sigma has the same active set in every finite element as the NLP
+  /// before it, the rest of the homotopy is replaced by one NLP with those active sets fixed
+  /// (theta = 0 off them, lambda = 0 on them; sliding exits pinned as with pin_sliding_exits),
+  /// whose complementarity holds exactly. If that NLP fails, the homotopy goes on, and that
+  /// active set is not tried again. The integrator skips steps with a sliding element and keeps
+  /// the fixed NLP only if it lies within sqrt(sigma) of the relaxed point. 0: off (every NLP
+  /// down to complementarity_tol). Measured (docs/formulation.md): 1e-3 ends OCP (61) on another
+  /// branch (cost 9.1710 instead of 9.1685); 1e-4 keeps every example's cost.
   double active_set_sigma = 1e-4;
 };
 

@@ -306,7 +306,7 @@ std::vector<Option> build() {
       kHom, "intermediate_tol", kBoth, "IPOPT tol of the NLPs with sigma > 10 complementarity_tol",
       "", Range{.min = 0, .note = "(0: ipopt.tol everywhere)"}));
   o.push_back(scalar<&T::homotopy, &H::active_set_sigma>(
-      kHom, "active_set_sigma", Use::Ocp,
+      kHom, "active_set_sigma", kBoth,
       "end the homotopy with the active set fixed once it is stable at sigma <= this", "",
       Range{.min = 0, .note = "(0: off)"}));
   o.push_back(scalar<&T::homotopy, &H::fix_active_set>(
