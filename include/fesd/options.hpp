@@ -152,7 +152,7 @@ struct HomotopyOptions {
 
 /// The linear solver behind IPOPT's KKT systems (docs/kkt-solver.md).
 enum class KktSolver {
-  Auto,       ///< dense LDL' for NLPs with n + m <= 128, the sparse LDL' above (default)
+  Auto,       ///< the sparse LDL' at every size (default; docs/kkt-solver.md)
   SparseLdl,  ///< fesd's sparse multifrontal LDL' at every size
   Dense,      ///< fesd's dense LAPACK LDL' at every size (O((n + m)^3) per factorization)
   Mumps,      ///< IPOPT's MUMPS

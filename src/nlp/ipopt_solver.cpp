@@ -179,11 +179,6 @@ class BlockTnlp final : public Ipopt::TNLP {
   int eval_failures_ = 0, iterations_ = 0;
 };
 
-/// Largest n + m solved with the dense LDL' under kkt_solver = auto; above it the sparse LDL'.
-/// Dense costs (n + m)^3 / 3 flops per factorization (docs/benchmarks.md). The KKT matrix also
-/// has a row per inequality's slack, so this is decided here, on the NLP, not in the module.
-constexpr int kDenseKktMax = FESD_KKT_DENSE_MAX;
-
 /// The KKT module's own entry points (kkt_module.h), found once its library is loaded.
 struct KktModule {
   void (*request_mode)(int) = nullptr;
@@ -312,10 +307,12 @@ NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_star
   if (impl_->user_linear_solver) {
     app.Options()->GetStringValue("linear_solver", name, "");
   } else {
-    const bool small = nlp.num_variables() + nlp.num_constraints() <= kDenseKktMax;
     switch (impl_->kkt_solver) {
+      // The sparse LDL' at every size: on the integrator's NLPs (n + m = 30-120), where auto used
+      // to pick the dense LAPACK solver, it takes 1.4-2.5x fewer instructions per run
+      // (docs/kkt-solver.md, "Choosing the solver").
       case KktSolver::Auto:
-        mode = small ? FESD_KKT_DENSE : FESD_KKT_SPARSE;
+        mode = FESD_KKT_SPARSE;
         break;
       case KktSolver::Dense:
         mode = FESD_KKT_DENSE;
