@@ -88,7 +88,9 @@ enum Header {
   kHMaxFront,  // largest front
   kHSymbolic,  // offset of the symbolic analysis (layout: Symbolic)
   kHEntries,   // entries of the permuted lower triangle (duplicates kept)
-  kHSupernodes
+  kHSupernodes,
+  kHFrontRows,  // sum of the supernodes' front sizes without delayed pivots
+  kHEdgeRows    // sum of the children's contribution rows without delayed pivots
 };
 // IKEEP[2N + 1 ..]: the symbolic analysis in IW is valid for this IW (address and length), so the
 // next factorization reuses it. IPOPT keeps IW between factorizations unless it reallocates it,
@@ -107,11 +109,25 @@ struct Symbolic {
   const int* sparent;   // ns: parent supernode, -1 at a root
   const int* cptr;      // ns + 1: each supernode's children ...
   const int* clist;     //   ... in increasing order
+  // Each supernode's front as it is without delayed pivots (the static front), kept so that a
+  // factorization builds no index lists: the rows, original numbering, own columns first
+  // (elimination order), then the others ascending in elimination order ...
+  const int* fptr;   // ns + 1
+  const int* frows;  //   ... (the delayed pivots of a factorization go between the two parts);
+  const int* amap;   // entries: static front position of crow[p] (column p's own front)
+  const int* eptr;   // clist entries + 1: per child (clist order), the static front positions in
+  const int* emap;   //   its parent of its contribution rows other than delayed pivots
   int ns = 0;
 };
 
-Index symbolic_length(int n, int nz, int entries, int ns) {
-  return static_cast<Index>(n) * 3 + 1 + entries + nz + 3 * static_cast<Index>(ns) + 2 + ns;
+Index symbolic_length(int n, int nz, int entries, int ns, int front_rows, int edge_rows) {
+  return static_cast<Index>(n) * 3 + 1 + entries + nz + 3 * static_cast<Index>(ns) + 2 + ns +
+         (static_cast<Index>(ns) + 1 + front_rows) + entries + (static_cast<Index>(ns) + edge_rows);
+}
+
+Index symbolic_length(const int* iw) {
+  return symbolic_length(iw[kHN], iw[kHNz], iw[kHEntries], iw[kHSupernodes], iw[kHFrontRows],
+                         iw[kHEdgeRows]);
 }
 
 Symbolic symbolic_view(const int* iw) {
@@ -135,6 +151,16 @@ Symbolic symbolic_view(const int* iw) {
   v.cptr = q;
   q += ns + 1;
   v.clist = q;
+  q += iw[kHSupernodes] > 0 ? v.cptr[ns] : 0;
+  v.fptr = q;
+  q += ns + 1;
+  v.frows = q;
+  q += iw[kHFrontRows];
+  v.amap = q;
+  q += entries;
+  v.eptr = q;
+  q += (ns > 0 ? v.cptr[ns] : 0) + 1;
+  v.emap = q;
   v.ns = ns;
   return v;
 }
@@ -497,12 +523,14 @@ FESD_KKT_KERNEL PivotResult partial_ldlt(int nf, int nfs, double* storage, int* 
   return res;
 }
 
-/// Contribution block a front passes to its parent: indices (permuted numbering), the first
-/// ndelayed of them delayed pivots, and the lower triangle (column-major m x m).
+/// Contribution block a front passes to its parent: the lower triangle (column-major m x m) of its
+/// rows, the first ndelayed of them delayed pivots (their indices in idx), the others the static
+/// front's rows below the fully summed ones (the parent's position map, Symbolic::emap, has them).
 struct Contribution {
-  std::vector<int> idx;
+  std::vector<int> idx;  // the delayed pivots (original numbering)
   std::vector<double> val;
   int ndelayed = 0;
+  int m = 0;  // rows of the block
 };
 
 /// Scratch memory of the factorization, kept per thread between calls (it holds no state: every
@@ -511,7 +539,7 @@ struct Contribution {
 /// page faults again.
 struct Workspace {
   std::vector<double> rmax, cval, front, w1, w2;
-  std::vector<int> pos, fidx, kind, lp;
+  std::vector<int> fidx, kind, lp;
   std::vector<Contribution> cb;
   std::vector<std::vector<double>> pool;
 };
@@ -653,7 +681,8 @@ void sparse_analyse(int n, int nz, const int* irn, const int* icn, int* ikeep, i
   // The relaxed supernodes store each front's pivot block square and pad chains: twice AMD's
   // count plus a margin; a factorization that needs more reports IFLAG = -4 and IPOPT grows A.
   const double la = nz + n + 2.0 * lnz + 20.0 * n + 1000.0;
-  const double liw = kHeader + 2.0 * nz + 4.0 * n + lnz + 1000.0;
+  // IW: pattern, symbolic analysis with the static fronts (their rows and position maps), records.
+  const double liw = kHeader + 3.0 * nz + 8.0 * n + 2.0 * lnz + 1000.0;
   const double cap = static_cast<double>(std::numeric_limits<int>::max() / 8);
   info[4] = static_cast<int>(std::min(la, cap));   // NRLNEC
   info[5] = static_cast<int>(std::min(liw, cap));  // NIRNEC
@@ -790,15 +819,62 @@ Index build_symbolic(int n, int nz, const int* irn, const int* icn, const int* p
       if (sparent[s] >= 0) clist[next[sparent[s]]++] = s;
   }
 
+  // Static fronts (no delayed pivots): rows, the original entries' positions and the children's
+  // contribution rows' positions, so that a factorization neither builds index lists nor sorts.
+  // Children before parents (a supernode's number is its last column's rank).
   const int entries = colptr[n];
-  const Index need = symbolic_length(n, nz, entries, ns);
+  std::vector<int> fptr(static_cast<std::size_t>(ns) + 1, 0), frows, amap(entries),
+      eptr(static_cast<std::size_t>(cptr[ns]) + 1, 0), emap;
+  {
+    std::vector<int> fpos(n, -1);
+    for (int s = 0; s < ns; ++s) {
+      const int start = static_cast<int>(frows.size());
+      const auto add = [&](int g) {
+        if (fpos[g] >= 0) return;
+        fpos[g] = 0;
+        frows.push_back(g);
+      };
+      const int nown = cols_ptr[s + 1] - cols_ptr[s];
+      for (int t = 0; t < nown; ++t) add(cols[cols_ptr[s] + t]);
+      for (int t = 0; t < nown; ++t) {
+        const int c = cols[cols_ptr[s] + t];
+        for (int p = colptr[c]; p < colptr[c + 1]; ++p) add(crow[p]);
+      }
+      for (int p = cptr[s]; p < cptr[s + 1]; ++p) {
+        const int ch = clist[p];
+        const int ch_own = cols_ptr[ch + 1] - cols_ptr[ch];
+        for (int i = fptr[ch] + ch_own; i < fptr[ch + 1]; ++i) add(frows[i]);
+      }
+      std::sort(frows.begin() + start + nown, frows.end());
+      const int end = static_cast<int>(frows.size());
+      for (int i = start; i < end; ++i) fpos[frows[i]] = i - start;
+      for (int t = 0; t < nown; ++t) {
+        const int c = cols[cols_ptr[s] + t];
+        for (int p = colptr[c]; p < colptr[c + 1]; ++p) amap[p] = fpos[crow[p]];
+      }
+      for (int p = cptr[s]; p < cptr[s + 1]; ++p) {
+        const int ch = clist[p];
+        const int ch_own = cols_ptr[ch + 1] - cols_ptr[ch];
+        for (int i = fptr[ch] + ch_own; i < fptr[ch + 1]; ++i) emap.push_back(fpos[frows[i]]);
+        eptr[p + 1] = static_cast<int>(emap.size());
+      }
+      for (int i = start; i < end; ++i) fpos[frows[i]] = -1;
+      fptr[s + 1] = end;
+    }
+  }
+  for (int& g : frows) g = perm[g];
+
+  const int front_rows = static_cast<int>(frows.size()), edge_rows = static_cast<int>(emap.size());
+  const Index need = symbolic_length(n, nz, entries, ns, front_rows, edge_rows);
   if (iw_at + need > liw) return iw_at + need;
   iw[kHSymbolic] = static_cast<int>(iw_at);
   iw[kHEntries] = entries;
   iw[kHSupernodes] = ns;
+  iw[kHFrontRows] = front_rows;
+  iw[kHEdgeRows] = edge_rows;
   int* q = iw + iw_at;
-  for (const std::vector<int>* v :
-       {&iperm, &colptr, &crow, &slot, &cols_ptr, &cols, &sparent, &cptr, &clist})
+  for (const std::vector<int>* v : {&iperm, &colptr, &crow, &slot, &cols_ptr, &cols, &sparent,
+                                    &cptr, &clist, &fptr, &frows, &amap, &eptr, &emap})
     q = std::copy(v->begin(), v->end(), q);
   return iw_at + need;
 }
@@ -863,10 +939,9 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
     }
   }
   const Symbolic sym = symbolic_view(iw);
-  const Index fixed_liw = iw[kHSymbolic] + symbolic_length(n, nz, iw[kHEntries], sym.ns);
+  const Index fixed_liw = iw[kHSymbolic] + symbolic_length(iw);
   iw[kHFirst] = iw[kHEnd] = static_cast<int>(fixed_liw);
-  const int* perm = ikeep;
-  const int *colptr = sym.colptr, *crow = sym.crow, *cols_ptr = sym.cols_ptr, *cols = sym.cols,
+  const int *colptr = sym.colptr, *cols_ptr = sym.cols_ptr, *cols = sym.cols,
             *sparent = sym.sparent, *cptr = sym.cptr, *clist = sym.clist;
   const int ns = sym.ns;
 
@@ -908,8 +983,7 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
   const double u = std::clamp(pivtol, kMinPivtol, kMaxPivtol);
 
   // Multifrontal factorization; children (smaller last columns) come before their parent.
-  std::vector<int>&pos = ws.pos, &fidx = ws.fidx, &kind = ws.kind;
-  pos.assign(n, -1);
+  std::vector<int>&fidx = ws.fidx, &kind = ws.kind;
   std::vector<double>&front = ws.front, &w1 = ws.w1, &w2 = ws.w2;
   std::vector<int>& w_pos = ws.lp;
   std::vector<Contribution>& cb = ws.cb;
@@ -922,6 +996,7 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
     c.val.clear();
     c.idx.clear();
     c.ndelayed = 0;
+    c.m = 0;
   };
   for (int s = 0; s < ns; ++s) release(cb[s]);
   Index a_next = fixed_la, iw_next = fixed_liw;
@@ -931,28 +1006,24 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
   for (int s = 0; s < ns; ++s) {
     const int* own = cols + cols_ptr[s];
     const int nown = cols_ptr[s + 1] - cols_ptr[s];
-    fidx.clear();
-    auto add = [&](int g) {
-      if (pos[g] >= 0) return;
-      pos[g] = static_cast<int>(fidx.size());
-      fidx.push_back(g);
-    };
-    for (int t = 0; t < nown; ++t) add(own[t]);
-    for (int p = cptr[s]; p < cptr[s + 1]; ++p) {
-      const Contribution& ch = cb[clist[p]];
-      for (int t = 0; t < ch.ndelayed; ++t) add(ch.idx[t]);
+    const int* srows = sym.frows + sym.fptr[s];
+    const int nf0 = sym.fptr[s + 1] - sym.fptr[s];
+    // Front order (original numbering): own columns, the children's delayed pivots (children in
+    // order), then the static front's other rows; a static position sp >= nown moves down by nd.
+    int nd = 0;
+    for (int p = cptr[s]; p < cptr[s + 1]; ++p) nd += cb[clist[p]].ndelayed;
+    const int nfs = nown + nd, nf = nf0 + nd;
+    fidx.resize(nf);
+    std::copy_n(srows, nown, fidx.begin());
+    {
+      int at = nown;
+      for (int p = cptr[s]; p < cptr[s + 1]; ++p) {
+        const Contribution& ch = cb[clist[p]];
+        at = static_cast<int>(std::copy_n(ch.idx.begin(), ch.ndelayed, fidx.begin() + at) -
+                              fidx.begin());
+      }
     }
-    const int nfs = static_cast<int>(fidx.size());
-    for (int t = 0; t < nown; ++t)
-      for (int p = colptr[own[t]]; p < colptr[own[t] + 1]; ++p) add(crow[p]);
-    for (int p = cptr[s]; p < cptr[s + 1]; ++p)
-      for (int g : cb[clist[p]].idx) add(g);
-    const int nf = static_cast<int>(fidx.size());
-    // Front order: own columns ascending, delayed pivots, then the other rows ascending. A child's
-    // rows other than its delayed ones are ascending too, so they land in ascending positions:
-    // the extend-add below needs no per-entry triangle test for them.
-    std::sort(fidx.begin() + nfs, fidx.end());
-    for (int i = nfs; i < nf; ++i) pos[fidx[i]] = i;
+    std::copy(srows + nown, srows + nf0, fidx.begin() + nfs);
     maxnf = std::max(maxnf, nf);
     const int ld = front_ld(nf);
     if (front.size() < static_cast<std::size_t>(ld) * nf)
@@ -961,21 +1032,32 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
     // One memset of the whole front: zeroing only the lower triangle took a memset call per
     // column (GCC turns the loop into one), more than the stores for these short columns.
     std::memset(fr, 0, sizeof(double) * static_cast<std::size_t>(ld) * nf);
+    const auto shifted = [nown, nd](int sp) { return sp >= nown ? sp + nd : sp; };
     for (int t = 0; t < nown; ++t) {
       const int c = own[t];
-      double* fc = fr + static_cast<std::size_t>(pos[c]) * ld;
-      for (int p = colptr[c]; p < colptr[c + 1]; ++p) fc[pos[crow[p]]] += cval[p];
+      double* fc = fr + static_cast<std::size_t>(t) * ld;
+      if (nd == 0)
+        for (int p = colptr[c]; p < colptr[c + 1]; ++p) fc[sym.amap[p]] += cval[p];
+      else
+        for (int p = colptr[c]; p < colptr[c + 1]; ++p) fc[shifted(sym.amap[p])] += cval[p];
     }
+    int delayed_at = nown;
     for (int p = cptr[s]; p < cptr[s + 1]; ++p) {
       Contribution& ch = cb[clist[p]];
-      const int m = static_cast<int>(ch.idx.size());
-      std::vector<int>& lp = w_pos;
-      lp.resize(m);
-      for (int b = 0; b < m; ++b) lp[b] = pos[ch.idx[b]];
+      const int m = ch.m, chd = ch.ndelayed;
+      const int* map = sym.emap + sym.eptr[p];
+      const int* lp = map;
+      if (nd > 0) {  // positions of the child's rows in this front
+        w_pos.resize(m);
+        for (int b = 0; b < chd; ++b) w_pos[b] = delayed_at + b;
+        for (int b = chd; b < m; ++b) w_pos[b] = shifted(map[b - chd]);
+        lp = w_pos.data();
+      }
+      delayed_at += chd;
       for (int jb = 0; jb < m; ++jb) {
         const int pj = lp[jb];
         const double* col = ch.val.data() + static_cast<std::size_t>(jb) * m;
-        if (jb < ch.ndelayed) {
+        if (jb < chd) {
           for (int ib = jb; ib < m; ++ib) {
             const int pi = lp[ib];
             const auto at = pi >= pj ? static_cast<std::size_t>(pj) * ld + pi
@@ -1004,7 +1086,7 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
       rec[0] = nf;
       rec[1] = ne;
       rec[2] = static_cast<int>(a_next);
-      for (int i = 0; i < nf; ++i) rec[3 + i] = perm[fidx[i]];
+      std::copy_n(fidx.data(), nf, rec + 3);
       std::copy_n(kind.data(), ne, rec + 3 + nf);
       rec[3 + nf + ne] = static_cast<int>(iw_next);
     }
@@ -1019,9 +1101,12 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
         singular = true;
         rank -= m;
       } else {
+        // The block's rows: the pivots delayed to the parent (indices kept), then the static
+        // front's rows below the fully summed ones (the parent's emap has their positions).
         Contribution& out = cb[s];
-        out.idx.assign(fidx.begin() + ne, fidx.end());
+        out.idx.assign(fidx.begin() + ne, fidx.begin() + nfs);
         out.ndelayed = nfs - ne;
+        out.m = m;
         if (!pool.empty()) {
           out.val = std::move(pool.back());
           pool.pop_back();
@@ -1032,7 +1117,6 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
                       out.val.data() + static_cast<std::size_t>(j) * m + j);
       }
     }
-    for (int g : fidx) pos[g] = -1;
   }
   if (stats != nullptr) {
     stats->delayed_pivots += delayed;
