@@ -333,6 +333,20 @@ FESD_KKT_INLINE void store4(double* p, Vec4 v) {
   __builtin_memcpy(p, &v, sizeof v);
 }
 
+/// Zeroes what the kernels read of a front: column j from row (j rounded down to a multiple of 4)
+/// - 4 to the padded end (the kernels' vector loops start up to 7 rows above a diagonal). Half
+/// the stores of a memset of the whole front. Kept a loop of stores (GCC's loop distribution would
+/// make it a memset call per column).
+[[gnu::noinline, gnu::optimize("no-tree-loop-distribute-patterns")]] void zero_front(double* f,
+                                                                                     int nf) {
+  const int ld = front_ld(nf);
+  const Vec4 zero = {};
+  for (int j = 0; j < nf; ++j) {
+    double* c = f + static_cast<std::size_t>(j) * ld;
+    for (int i = std::max(0, (j & ~3) - 4); i < ld; i += 4) store4(c + i, zero);
+  }
+}
+
 /// C(:, j0 .. j0 + NB) -= L W for a front's contribution columns j0 .. j0 + NB: L = the front's
 /// first k columns, W = (D L') (row t at w + t ldw). Rows four at a time, from j0 rounded down to
 /// a multiple of 4 to the padded end of the column, with NB vector accumulators over all k pivots,
@@ -406,6 +420,46 @@ FESD_KKT_INLINE double dot(const double* x, const double* y, int from, int to) {
   return s;
 }
 
+/// max |x(i)| over i = from .. ld (ld a multiple of 4), vectorized from the next multiple of 4.
+FESD_KKT_INLINE double abs_max(const double* x, int from, int ld) {
+  using Bits = long long __attribute__((vector_size(32)));
+  double m = 0.0;
+  int i = from;
+  for (; i < ld && (i & 3) != 0; ++i) m = std::max(m, std::abs(x[i]));
+  if (i < ld) {
+    constexpr long long kMagnitude = 0x7fffffffffffffffLL;  // all bits but the sign
+    const Bits magnitude = {kMagnitude, kMagnitude, kMagnitude, kMagnitude};
+    Vec4 acc = {};
+    for (; i < ld; i += 4) {
+      const Vec4 v = reinterpret_cast<Vec4>(reinterpret_cast<Bits>(load4(x + i)) & magnitude);
+      acc = acc > v ? acc : v;
+    }
+    m = std::max({m, acc[0], acc[1], acc[2], acc[3]});
+  }
+  return m;
+}
+
+/// w(i) = c(i), c(i) = c(i) / d for i = from .. nf; w(i) = c(i) for i = nf .. ld (padding).
+/// Vector divisions round as scalar ones.
+FESD_KKT_INLINE void copy_and_scale(double* w, double* c, double d, int from, int nf, int ld) {
+  int i = from;
+  for (; i < nf && (i & 3) != 0; ++i) {
+    w[i] = c[i];
+    c[i] = w[i] / d;
+  }
+  const Vec4 dv = {d, d, d, d};
+  for (; i + 4 <= nf; i += 4) {
+    const Vec4 x = load4(c + i);
+    store4(w + i, x);
+    store4(c + i, x / dv);
+  }
+  for (; i < nf; ++i) {
+    w[i] = c[i];
+    c[i] = w[i] / d;
+  }
+  for (; i < ld; ++i) w[i] = c[i];
+}
+
 struct PivotResult {
   int nelim = 0;
   int negative = 0;
@@ -428,28 +482,29 @@ FESD_KKT_KERNEL PivotResult partial_ldlt(int nf, int nfs, double* storage, int* 
   while (k < nfs) {
     int pivot_p = -1, pivot_q = -1;
     for (int p = k; p < nfs && pivot_p < 0; ++p) {
-      double cmax = 0.0, qmax = 0.0;
+      // The column maximum first (vectorized); the 2x2 partner only if the 1x1 test fails.
+      double cmax = abs_max(F.col(p), p + 1, ld);
+      for (int i = k; i < p; ++i) cmax = std::max(cmax, std::abs(F.at(p, i)));
+      const double app = F.at(p, p);
+      if (std::abs(app) > tiny && std::abs(app) >= u * cmax) {
+        pivot_p = p;
+        break;
+      }
+      double qmax = 0.0;
       int q = -1;
       for (int i = k; i < p; ++i) {
         const double v = std::abs(F.at(p, i));
-        cmax = std::max(cmax, v);
         if (v > qmax) {
           qmax = v;
           q = i;
         }
       }
-      for (int i = p + 1; i < nf; ++i) {
+      for (int i = p + 1; i < nfs; ++i) {
         const double v = std::abs(F.at(i, p));
-        cmax = std::max(cmax, v);
-        if (i < nfs && v > qmax) {
+        if (v > qmax) {
           qmax = v;
           q = i;
         }
-      }
-      const double app = F.at(p, p);
-      if (std::abs(app) > tiny && std::abs(app) >= u * cmax) {
-        pivot_p = p;
-        break;
       }
       if (q < 0 || qmax <= tiny) continue;
       // 2x2 candidate (p, q): column maxima outside the block, then |D^-1| [cp; cq] <= 1/u.
@@ -475,13 +530,13 @@ FESD_KKT_KERNEL PivotResult partial_ldlt(int nf, int nfs, double* storage, int* 
       const double d = F.at(k, k);
       if (d < 0) ++res.negative;
       double* wk = w1.data();
-      // Rows (k + 1) & ~3 .. k of wk keep what they held: axpy_down adds them only to the unused
-      // upper triangle.
-      for (int i = k + 1; i < ld; ++i) wk[i] = F.at(i, k);  // padding rows: zero
-      // Fully summed columns now; the contribution block gets one update at the end.
-      for (int j = k + 1; j < nfs; ++j) axpy_down(F.col(j), wk, wk[j] / d, j, ld);
       double* ck = F.col(k);
-      for (int i = k + 1; i < nf; ++i) ck[i] = wk[i] / d;
+      // wk = column k below the pivot (padding rows: zero), column k = L = wk / d. Rows
+      // (k + 1) & ~3 .. k of wk keep what they held: axpy_down adds them only to the unused upper
+      // triangle.
+      copy_and_scale(wk, ck, d, k + 1, nf, ld);
+      // Fully summed columns now; the contribution block gets one update at the end.
+      for (int j = k + 1; j < nfs; ++j) axpy_down(F.col(j), wk, ck[j], j, ld);
       kind[k] = 1;
       k += 1;
     } else {
@@ -1029,9 +1084,7 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
     if (front.size() < static_cast<std::size_t>(ld) * nf)
       front.resize(static_cast<std::size_t>(ld) * nf);
     double* fr = front.data();
-    // One memset of the whole front: zeroing only the lower triangle took a memset call per
-    // column (GCC turns the loop into one), more than the stores for these short columns.
-    std::memset(fr, 0, sizeof(double) * static_cast<std::size_t>(ld) * nf);
+    zero_front(fr, nf);
     const auto shifted = [nown, nd](int sp) { return sp >= nown ? sp + nd : sp; };
     for (int t = 0; t < nown; ++t) {
       const int c = own[t];
@@ -1046,27 +1099,35 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
       Contribution& ch = cb[clist[p]];
       const int m = ch.m, chd = ch.ndelayed;
       const int* map = sym.emap + sym.eptr[p];
-      const int* lp = map;
-      if (nd > 0) {  // positions of the child's rows in this front
+      if (nd == 0) {
+        // No delayed pivots (chd = 0 too): the static map as it is, no triangle test. (Vector adds
+        // for runs of consecutive positions, precomputed: as many instructions, no faster.)
+        for (int jb = 0; jb < m; ++jb) {
+          const double* col = ch.val.data() + static_cast<std::size_t>(jb) * m;
+          double* fc = fr + static_cast<std::size_t>(map[jb]) * ld;
+          for (int ib = jb; ib < m; ++ib) fc[map[ib]] += col[ib];
+        }
+      } else {
+        // Positions of the child's rows in this front: its delayed pivots, then its static rows.
         w_pos.resize(m);
         for (int b = 0; b < chd; ++b) w_pos[b] = delayed_at + b;
         for (int b = chd; b < m; ++b) w_pos[b] = shifted(map[b - chd]);
-        lp = w_pos.data();
-      }
-      delayed_at += chd;
-      for (int jb = 0; jb < m; ++jb) {
-        const int pj = lp[jb];
-        const double* col = ch.val.data() + static_cast<std::size_t>(jb) * m;
-        if (jb < chd) {
-          for (int ib = jb; ib < m; ++ib) {
-            const int pi = lp[ib];
-            const auto at = pi >= pj ? static_cast<std::size_t>(pj) * ld + pi
-                                     : static_cast<std::size_t>(pi) * ld + pj;
-            fr[at] += col[ib];
+        delayed_at += chd;
+        const int* lp = w_pos.data();
+        for (int jb = 0; jb < m; ++jb) {
+          const int pj = lp[jb];
+          const double* col = ch.val.data() + static_cast<std::size_t>(jb) * m;
+          if (jb < chd) {
+            for (int ib = jb; ib < m; ++ib) {
+              const int pi = lp[ib];
+              const auto at = pi >= pj ? static_cast<std::size_t>(pj) * ld + pi
+                                       : static_cast<std::size_t>(pi) * ld + pj;
+              fr[at] += col[ib];
+            }
+          } else {
+            double* fc = fr + static_cast<std::size_t>(pj) * ld;
+            for (int ib = jb; ib < m; ++ib) fc[lp[ib]] += col[ib];
           }
-        } else {
-          double* fc = fr + static_cast<std::size_t>(pj) * ld;
-          for (int ib = jb; ib < m; ++ib) fc[lp[ib]] += col[ib];
         }
       }
       release(ch);
