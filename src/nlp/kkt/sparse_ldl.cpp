@@ -278,6 +278,13 @@ void compute_ordering(int n, int nz, const int* irn, const int* icn, const doubl
   }
 }
 
+/// Makes v at least n long. Scratch vectors only grow: resizing one down and up again zero-filled
+/// it every time (a memset per front for the contribution blocks).
+template <class T>
+void grow(std::vector<T>& v, std::size_t n) {
+  if (v.size() < n) v.resize(n);
+}
+
 /// Rows of a front's column in storage: nf rounded up to a multiple of 4, so the vector kernels
 /// need no remainder loops (the padding rows stay zero).
 inline int front_ld(int nf) {
@@ -378,7 +385,7 @@ FESD_KKT_KERNEL void update_contribution(int nf, int nfs, int k, double* f, cons
   const std::size_t lds = static_cast<std::size_t>(ld);
   // W = D L21' (k x m, by rows): row t is pivot t's column of L below the fully summed rows
   // times D.
-  wbuf.resize(static_cast<std::size_t>(k) * m);
+  grow(wbuf, static_cast<std::size_t>(k) * m);
   double* w = wbuf.data();
   for (int t = 0; t < k;) {
     const double* lt = f + t * lds + nfs;
@@ -476,8 +483,8 @@ FESD_KKT_KERNEL PivotResult partial_ldlt(int nf, int nfs, double* storage, int* 
   Front F(storage, nf);
   const int ld = front_ld(nf);
   PivotResult res;
-  w1.resize(ld);
-  w2.resize(ld);
+  grow(w1, ld);
+  grow(w2, ld);
   int k = 0;
   while (k < nfs) {
     int pivot_p = -1, pivot_q = -1;
@@ -1026,7 +1033,7 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
 
   // Scaled values in the permuted lower triangle.
   std::vector<double>& cval = ws.cval;
-  cval.assign(static_cast<std::size_t>(iw[kHEntries]), 0.0);
+  grow(cval, static_cast<std::size_t>(iw[kHEntries]));  // every entry is written below
   double amax = 0.0;
   for (int e = 0; e < nz; ++e) {
     if (sym.slot[e] < 0) continue;
@@ -1048,7 +1055,6 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
   if (cb.size() < static_cast<std::size_t>(ns)) cb.resize(ns);
   const auto release = [&pool](Contribution& c) {
     if (c.val.capacity() > 0) pool.push_back(std::move(c.val));
-    c.val.clear();
     c.idx.clear();
     c.ndelayed = 0;
     c.m = 0;
@@ -1132,7 +1138,7 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
       }
       release(ch);
     }
-    kind.assign(nf, 0);
+    grow(kind, nf);
     const PivotResult pr =
         partial_ldlt(nf, nfs, front.data(), fidx.data(), kind.data(), u, tiny, w1, w2);
     const int ne = pr.nelim;
@@ -1172,7 +1178,7 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
           out.val = std::move(pool.back());
           pool.pop_back();
         }
-        out.val.resize(static_cast<std::size_t>(m) * m);
+        grow(out.val, static_cast<std::size_t>(m) * m);
         for (int j = 0; j < m; ++j)  // lower triangle
           std::copy_n(fr + static_cast<std::size_t>(ne + j) * ld + ne + j, m - j,
                       out.val.data() + static_cast<std::size_t>(j) * m + j);
