@@ -613,7 +613,8 @@ struct Workspace {
 }
 
 /// Applies the factor to v in place: v <- S (L D L')^-1 S v.
-FESD_KKT_KERNEL void apply_inverse(const double* a, const int* iw, double* v, double* w) {
+FESD_KKT_KERNEL void apply_inverse(const double* __restrict a, const int* __restrict iw,
+                                   double* __restrict v, double* __restrict w) {
   const int n = iw[kHN], nz = iw[kHNz];
   const double* scale = a + nz;
   for (int i = 0; i < n; ++i) v[i] *= scale[i];
@@ -1018,16 +1019,27 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
     rmax.resize(n);
     // The pattern in IW: 0-based, -1 for out-of-range entries.
     const int *prow = iw + kHeader, *pcol = prow + nz;
-    for (int sweep = 0; sweep < 3; ++sweep) {
+    // Every triplet in range (the usual case): no per-entry test. The first sweep has scale = 1.
+    const bool all_valid = iw[kHEntries] == nz;
+    const auto sweep = [&]<bool kChecked, bool kFirst>() {
       std::fill(rmax.begin(), rmax.end(), 0.0);
       for (int e = 0; e < nz; ++e) {
         const int i = prow[e], j = pcol[e];
-        if (i < 0) continue;
-        const double v = std::abs(a[e]) * scale[i] * scale[j];
+        if (kChecked && i < 0) continue;
+        const double v = kFirst ? std::abs(a[e]) : std::abs(a[e]) * scale[i] * scale[j];
         rmax[i] = std::max(rmax[i], v);
         rmax[j] = std::max(rmax[j], v);
       }
       for (int i = 0; i < n; ++i) scale[i] *= inverse_sqrt_pow2(rmax[i]);
+    };
+    if (all_valid) {
+      sweep.template operator()<false, true>();
+      sweep.template operator()<false, false>();
+      sweep.template operator()<false, false>();
+    } else {
+      sweep.template operator()<true, true>();
+      sweep.template operator()<true, false>();
+      sweep.template operator()<true, false>();
     }
   }
 
@@ -1035,11 +1047,15 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
   std::vector<double>& cval = ws.cval;
   grow(cval, static_cast<std::size_t>(iw[kHEntries]));  // every entry is written below
   double amax = 0.0;
-  for (int e = 0; e < nz; ++e) {
-    if (sym.slot[e] < 0) continue;
-    const double v = a[e] * scale[irn[e] - 1] * scale[icn[e] - 1];
-    amax = std::max(amax, std::abs(v));
-    cval[sym.slot[e]] = v;
+  {
+    const int *prow = iw + kHeader, *pcol = prow + nz;
+    for (int e = 0; e < nz; ++e) {
+      const int i = prow[e];
+      if (i < 0) continue;
+      const double v = a[e] * scale[i] * scale[pcol[e]];
+      amax = std::max(amax, std::abs(v));
+      cval[sym.slot[e]] = v;
+    }
   }
   const double tiny = kTinyRel * std::max(amax, std::numeric_limits<double>::min());
   const double u = std::clamp(pivtol, kMinPivtol, kMaxPivtol);
