@@ -593,6 +593,10 @@ struct Contribution {
   std::vector<double> val;
   int ndelayed = 0;
   int m = 0;  // rows of the block
+  /// The block's first entry and leading dimension: in val (m), or in the front buffer it was
+  /// computed in when the parent is the next front.
+  const double* block = nullptr;
+  int ldb = 0;
 };
 
 /// Scratch memory of the factorization, kept per thread between calls (it holds no state: every
@@ -600,7 +604,7 @@ struct Contribution {
 /// ~3000-row KKT matrix: glibc returned the freed memory to the kernel and the next call paid
 /// page faults again.
 struct Workspace {
-  std::vector<double> rmax, cval, front, w1, w2;
+  std::vector<double> rmax, cval, front[2], w1, w2;
   std::vector<int> fidx, kind, lp;
   std::vector<Contribution> cb;
   std::vector<std::vector<double>> pool;
@@ -1062,7 +1066,7 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
 
   // Multifrontal factorization; children (smaller last columns) come before their parent.
   std::vector<int>&fidx = ws.fidx, &kind = ws.kind;
-  std::vector<double>&front = ws.front, &w1 = ws.w1, &w2 = ws.w2;
+  std::vector<double>&w1 = ws.w1, &w2 = ws.w2;
   std::vector<int>& w_pos = ws.lp;
   std::vector<Contribution>& cb = ws.cb;
   std::vector<std::vector<double>>& pool = ws.pool;
@@ -1103,8 +1107,10 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
     std::copy(srows + nown, srows + nf0, fidx.begin() + nfs);
     maxnf = std::max(maxnf, nf);
     const int ld = front_ld(nf);
-    if (front.size() < static_cast<std::size_t>(ld) * nf)
-      front.resize(static_cast<std::size_t>(ld) * nf);
+    // Fronts alternate between two buffers: a front whose parent comes next leaves its
+    // contribution block in place, and the parent reads it from there (no copy).
+    std::vector<double>& front = ws.front[s & 1];
+    grow(front, static_cast<std::size_t>(ld) * nf);
     double* fr = front.data();
     zero_front(fr, nf);
     const auto shifted = [nown, nd](int sp) { return sp >= nown ? sp + nd : sp; };
@@ -1125,7 +1131,7 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
         // No delayed pivots (chd = 0 too): the static map as it is, no triangle test. (Vector adds
         // for runs of consecutive positions, precomputed: as many instructions, no faster.)
         for (int jb = 0; jb < m; ++jb) {
-          const double* col = ch.val.data() + static_cast<std::size_t>(jb) * m;
+          const double* col = ch.block + static_cast<std::size_t>(jb) * ch.ldb;
           double* fc = fr + static_cast<std::size_t>(map[jb]) * ld;
           for (int ib = jb; ib < m; ++ib) fc[map[ib]] += col[ib];
         }
@@ -1138,7 +1144,7 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
         const int* lp = w_pos.data();
         for (int jb = 0; jb < m; ++jb) {
           const int pj = lp[jb];
-          const double* col = ch.val.data() + static_cast<std::size_t>(jb) * m;
+          const double* col = ch.block + static_cast<std::size_t>(jb) * ch.ldb;
           if (jb < chd) {
             for (int ib = jb; ib < m; ++ib) {
               const int pi = lp[ib];
@@ -1190,14 +1196,21 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
         out.idx.assign(fidx.begin() + ne, fidx.begin() + nfs);
         out.ndelayed = nfs - ne;
         out.m = m;
-        if (!pool.empty()) {
-          out.val = std::move(pool.back());
-          pool.pop_back();
+        if (sparent[s] == s + 1) {  // in place (the next front uses the other buffer)
+          out.block = fr + static_cast<std::size_t>(ne) * ld + ne;
+          out.ldb = ld;
+        } else {
+          if (!pool.empty()) {
+            out.val = std::move(pool.back());
+            pool.pop_back();
+          }
+          grow(out.val, static_cast<std::size_t>(m) * m);
+          for (int j = 0; j < m; ++j)  // lower triangle
+            std::copy_n(fr + static_cast<std::size_t>(ne + j) * ld + ne + j, m - j,
+                        out.val.data() + static_cast<std::size_t>(j) * m + j);
+          out.block = out.val.data();
+          out.ldb = m;
         }
-        grow(out.val, static_cast<std::size_t>(m) * m);
-        for (int j = 0; j < m; ++j)  // lower triangle
-          std::copy_n(fr + static_cast<std::size_t>(ne + j) * ld + ne + j, m - j,
-                      out.val.data() + static_cast<std::size_t>(j) * m + j);
       }
     }
   }
