@@ -6,8 +6,9 @@
 // (everything: IPOPT, derivatives, KKT), IPOPT's factorization time per iteration, and the
 // objective. Then matrices of the sparse_ldl run (every --stride-th, at most --matrices) are
 // factorized again, outside IPOPT, by fesd's sparse LDL' (its MA27 interface) and by MUMPS
-// (called directly with IPOPT 3.11's settings), --repeat times each: time per factorization of
-// the same matrices, analysis excluded.
+// (called directly with IPOPT 3.11's settings): after one untimed pass each, --repeat passes over
+// the matrices, the two solvers' passes alternating; the median pass's CPU time per factorization
+// of the same matrices, analysis excluded.
 //
 //   kkt_solver [--stages 6,12,24] [--solvers dense,mumps,sparse_ldl] [--dense-max 1000]
 //              [--stride 7] [--matrices 40] [--repeat 5] [--csv FILE] [--json FILE]
@@ -21,6 +22,8 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
@@ -103,89 +106,136 @@ struct Matrix {
   std::vector<double> a;
 };
 
-/// Mean seconds of fesd's sparse factorization over the matrices (one structure), after one
-/// untimed factorization (ordering and symbolic analysis).
-double time_sparse_ldl(const Module& m, const std::vector<Matrix>& mats, int repeat) {
-  const Matrix& s = mats.front();
-  int icntl[30], info[20], nsteps = 0, iflag = 0, maxfrt = 0;
-  double cntl[5], ops = 0;
-  m.ma27id(icntl, cntl);
-  cntl[0] = 1e-8;  // IPOPT's ma27_pivtol
-  std::vector<int> ikeep(3 * static_cast<std::size_t>(s.n)), iw1(2 * static_cast<std::size_t>(s.n));
-  int liw0 = 2 * (2 * s.nz + 3 * s.n + 1);
-  std::vector<int> iw0(static_cast<std::size_t>(liw0));
-  m.request_mode(FESD_KKT_SPARSE);
-  m.ma27ad(&s.n, &s.nz, s.irn.data(), s.icn.data(), iw0.data(), &liw0, ikeep.data(), iw1.data(),
-           &nsteps, &iflag, icntl, cntl, info, &ops);
-  m.request_mode(FESD_KKT_AUTO);
-  int la = std::max(s.nz, 5 * info[4]), liw = 5 * info[5];
-  std::vector<double> a(static_cast<std::size_t>(la));
-  std::vector<int> iw(static_cast<std::size_t>(liw));
-  auto factor = [&](const Matrix& x) {
+/// fesd's sparse factorization of the matrices (one structure) through its MA27 interface: the
+/// analysis and one untimed pass over them (ordering, symbolic analysis, the scratch memory's
+/// growth) at construction, then pass() times one factorization of each, in CPU seconds.
+class SparseLdlRunner {
+ public:
+  SparseLdlRunner(const Module& m, const std::vector<Matrix>& mats) : m_(m), mats_(mats) {
+    const Matrix& s = mats.front();
+    int icntl_iflag = 0, info[20];
+    double ops = 0;
+    m.ma27id(icntl_, cntl_);
+    cntl_[0] = 1e-8;  // IPOPT's ma27_pivtol
+    ikeep_.resize(3 * static_cast<std::size_t>(s.n));
+    iw1_.resize(2 * static_cast<std::size_t>(s.n));
+    int liw0 = 2 * (2 * s.nz + 3 * s.n + 1);
+    std::vector<int> iw0(static_cast<std::size_t>(liw0));
+    m.request_mode(FESD_KKT_SPARSE);
+    m.ma27ad(&s.n, &s.nz, s.irn.data(), s.icn.data(), iw0.data(), &liw0, ikeep_.data(), iw1_.data(),
+             &nsteps_, &icntl_iflag, icntl_, cntl_, info, &ops);
+    m.request_mode(FESD_KKT_AUTO);
+    la_ = std::max(s.nz, 5 * info[4]);
+    liw_ = 5 * info[5];
+    a_.resize(static_cast<std::size_t>(la_));
+    iw_.resize(static_cast<std::size_t>(liw_));
+    for (const Matrix& x : mats_) factor(x);
+  }
+  double pass() {
+    const double t0 = cpu_now();
+    for (const Matrix& x : mats_) factor(x);
+    return seconds_since(t0) / static_cast<double>(mats_.size());
+  }
+
+ private:
+  void factor(const Matrix& x) {
+    int info[20];
     for (;;) {
-      std::copy(x.a.begin(), x.a.end(), a.begin());
-      m.ma27bd(&x.n, &x.nz, x.irn.data(), x.icn.data(), a.data(), &la, iw.data(), &liw,
-               ikeep.data(), &nsteps, &maxfrt, iw1.data(), icntl, cntl, info);
+      std::copy(x.a.begin(), x.a.end(), a_.begin());
+      m_.ma27bd(&x.n, &x.nz, x.irn.data(), x.icn.data(), a_.data(), &la_, iw_.data(), &liw_,
+                ikeep_.data(), &nsteps_, &maxfrt_, iw1_.data(), icntl_, cntl_, info);
       if (info[0] == -3) {
-        liw = 2 * info[1];
-        iw.assign(static_cast<std::size_t>(liw), 0);
+        liw_ = 2 * info[1];
+        iw_.assign(static_cast<std::size_t>(liw_), 0);
       } else if (info[0] == -4) {
-        la = 2 * info[1];
-        a.assign(static_cast<std::size_t>(la), 0.0);
+        la_ = 2 * info[1];
+        a_.assign(static_cast<std::size_t>(la_), 0.0);
       } else {
         return;
       }
     }
-  };
-  factor(s);
-  const double t0 = cpu_now();
-  for (int r = 0; r < repeat; ++r)
-    for (const Matrix& x : mats) factor(x);
-  return seconds_since(t0) / (static_cast<double>(repeat) * static_cast<double>(mats.size()));
-}
+  }
+  const Module& m_;
+  const std::vector<Matrix>& mats_;
+  int icntl_[30] = {}, nsteps_ = 0, maxfrt_ = 0, la_ = 0, liw_ = 0;
+  double cntl_[5] = {};
+  std::vector<int> ikeep_, iw1_, iw_;
+  std::vector<double> a_;
+};
 
-/// Mean seconds of MUMPS's factorization (JOB = 2) over the matrices, with IPOPT 3.11's MUMPS
-/// settings (symmetric indefinite, pivtol 1e-6, scaling 77, ordering and permutation automatic,
-/// mem_percent 1000), after one analysis (JOB = 1).
-double time_mumps(const std::vector<Matrix>& mats, int repeat) {
-  DMUMPS_STRUC_C id{};
-  id.comm_fortran = -987654;  // USE_COMM_WORLD (the sequential MPI stub)
-  id.par = 1;
-  id.sym = 2;
-  id.job = -1;
-  dmumps_c(&id);
-  id.icntl[0] = id.icntl[1] = id.icntl[2] = -1;  // no output
-  id.icntl[3] = 0;
-  id.icntl[5] = 7;      // ICNTL(6) permuting_scaling
-  id.icntl[6] = 7;      // ICNTL(7) pivot order: automatic
-  id.icntl[7] = 77;     // ICNTL(8) scaling: automatic
-  id.icntl[9] = 0;      // ICNTL(10) no iterative refinement
-  id.icntl[13] = 1000;  // ICNTL(14) memory percent
-  id.cntl[0] = 1e-6;    // CNTL(1) pivtol
-  const Matrix& s = mats.front();
-  std::vector<int> irn = s.irn, icn = s.icn;
-  std::vector<double> a = s.a;
-  id.n = s.n;
-  id.nz = s.nz;
-  id.irn = irn.data();
-  id.jcn = icn.data();
-  id.a = a.data();
-  id.job = 1;
-  dmumps_c(&id);
-  const auto factor = [&](const Matrix& x) {
-    std::copy(x.a.begin(), x.a.end(), a.begin());
-    id.job = 2;
-    dmumps_c(&id);
+/// MUMPS's factorization (JOB = 2) of the matrices with IPOPT 3.11's MUMPS settings (symmetric
+/// indefinite, pivtol 1e-6, scaling 77, ordering and permutation automatic, mem_percent 1000):
+/// one analysis (JOB = 1) and one untimed pass at construction, then pass() as above.
+class MumpsRunner {
+ public:
+  explicit MumpsRunner(const std::vector<Matrix>& mats) : mats_(mats) {
+    id_.comm_fortran = -987654;  // USE_COMM_WORLD (the sequential MPI stub)
+    id_.par = 1;
+    id_.sym = 2;
+    id_.job = -1;
+    dmumps_c(&id_);
+    id_.icntl[0] = id_.icntl[1] = id_.icntl[2] = -1;  // no output
+    id_.icntl[3] = 0;
+    id_.icntl[5] = 7;      // ICNTL(6) permuting_scaling
+    id_.icntl[6] = 7;      // ICNTL(7) pivot order: automatic
+    id_.icntl[7] = 77;     // ICNTL(8) scaling: automatic
+    id_.icntl[9] = 0;      // ICNTL(10) no iterative refinement
+    id_.icntl[13] = 1000;  // ICNTL(14) memory percent
+    id_.cntl[0] = 1e-6;    // CNTL(1) pivtol
+    const Matrix& s = mats.front();
+    irn_ = s.irn;
+    icn_ = s.icn;
+    a_ = s.a;
+    id_.n = s.n;
+    id_.nz = s.nz;
+    id_.irn = irn_.data();
+    id_.jcn = icn_.data();
+    id_.a = a_.data();
+    id_.job = 1;
+    dmumps_c(&id_);
+    for (const Matrix& x : mats_) factor(x);
+  }
+  ~MumpsRunner() {
+    id_.job = -2;
+    dmumps_c(&id_);
+  }
+  MumpsRunner(const MumpsRunner&) = delete;
+  MumpsRunner& operator=(const MumpsRunner&) = delete;
+  double pass() {
+    const double t0 = cpu_now();
+    for (const Matrix& x : mats_) factor(x);
+    return seconds_since(t0) / static_cast<double>(mats_.size());
+  }
+
+ private:
+  void factor(const Matrix& x) {
+    std::copy(x.a.begin(), x.a.end(), a_.begin());
+    id_.job = 2;
+    dmumps_c(&id_);
+  }
+  const std::vector<Matrix>& mats_;
+  DMUMPS_STRUC_C id_{};
+  std::vector<int> irn_, icn_;
+  std::vector<double> a_;
+};
+
+/// Median CPU seconds per factorization of either solver over `repeat` passes, the two solvers'
+/// passes alternating: on a shared machine the load changes by up to 2x within seconds, and
+/// timing one solver after the other put different loads into one ratio.
+std::pair<double, double> time_both(const Module& m, const std::vector<Matrix>& mats, int repeat) {
+  SparseLdlRunner sparse(m, mats);
+  MumpsRunner mumps(mats);
+  std::vector<double> ts, tm;
+  for (int r = 0; r < std::max(1, repeat); ++r) {
+    ts.push_back(sparse.pass());
+    tm.push_back(mumps.pass());
+  }
+  const auto median = [](std::vector<double>& v) {
+    std::sort(v.begin(), v.end());
+    const std::size_t h = v.size() / 2;
+    return v.size() % 2 == 1 ? v[h] : 0.5 * (v[h - 1] + v[h]);
   };
-  factor(s);
-  const double t0 = cpu_now();
-  for (int r = 0; r < repeat; ++r)
-    for (const Matrix& x : mats) factor(x);
-  const double t =
-      seconds_since(t0) / (static_cast<double>(repeat) * static_cast<double>(mats.size()));
-  id.job = -2;
-  dmumps_c(&id);
-  return t;
+  return {median(ts), median(tm)};
 }
 
 struct Row {
@@ -334,12 +384,14 @@ int main(int argc, char** argv) {
       d.N_stages = N;
       d.kkt_rows = n0;
       d.matrices = static_cast<int>(captured.size());
-      d.sparse_ldl_s = time_sparse_ldl(module, captured, repeat);
-      d.mumps_s = time_mumps(captured, repeat);
+      std::tie(d.sparse_ldl_s, d.mumps_s) = time_both(module, captured, repeat);
       direct.push_back(d);
     }
   }
-  fmt::print("\nsame matrices, factorization only (analysis excluded), mean of each:\n");
+  fmt::print(
+      "\nsame matrices, factorization only (analysis excluded), CPU ms per factorization, median "
+      "of {} passes over them, the two solvers' passes alternating:\n",
+      repeat);
   fmt::print("{:>8} {:>6} {:>9} {:>16} {:>11} {:>8}\n", "N_stages", "kkt", "matrices",
              "sparse_ldl ms", "mumps ms", "ratio");
   for (const Direct& d : direct)

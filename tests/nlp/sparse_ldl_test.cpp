@@ -28,6 +28,7 @@ struct Module {
                  const int*, int*, int*, int*, int*, int*, double*, int*) = nullptr;
   void (*ma27cd)(const int*, double*, const int*, int*, const int*, double*, const int*, double*,
                  int*, const int*, int*, double*) = nullptr;
+  void (*stats)(FesdKktStats*) = nullptr;
 };
 
 const Module& module() {
@@ -40,6 +41,7 @@ const Module& module() {
     r.ma27ad = reinterpret_cast<decltype(r.ma27ad)>(dlsym(h, "ma27ad_"));
     r.ma27bd = reinterpret_cast<decltype(r.ma27bd)>(dlsym(h, "ma27bd_"));
     r.ma27cd = reinterpret_cast<decltype(r.ma27cd)>(dlsym(h, "ma27cd_"));
+    r.stats = reinterpret_cast<decltype(r.stats)>(dlsym(h, "fesd_kkt_stats"));
     return r;
   }();
   return m;
@@ -233,6 +235,47 @@ TEST(SparseLdl, SameValuesFactorizedAgainGiveTheSameSolution) {
   EXPECT_LT(backward_error(1.5 * t.dense(), x2, b), 1e-14);
   ASSERT_EQ(solver.factor(t.val), 0);
   EXPECT_EQ(solver.solve(b), x1);
+}
+
+long long delayed_pivots() {
+  FesdKktStats st{};
+  module().stats(&st);
+  return st.delayed_pivots;
+}
+
+TEST(SparseLdl, DelayedPivotsChangingBetweenFactorizationsOfOneStructure) {
+  // The factorization keeps each front's rows and assembly maps per structure and shifts them by
+  // the pivots its children delay. First values with -1 on the constraint diagonal (the ordering,
+  // matched on them, pairs no constraint row with a variable), then the same matrix with zero
+  // constraint diagonals (constraint rows before their variables: delayed pivots), then the first
+  // values again (the same solution, bit for bit).
+  ASSERT_NE(module().stats, nullptr);
+  std::mt19937 rng(21);
+  int with_delays = 0;
+  for (int trial = 0; trial < 12; ++trial) {
+    const int n = 40 + static_cast<int>(rng() % 120), m = 5 + static_cast<int>(rng() % (n / 3));
+    const Triplets z = random_kkt(rng, n, m, 0.0);
+    Triplets t = z;
+    for (int e = 0; e < t.nz(); ++e)
+      if (t.irn[e] == t.icn[e] && t.irn[e] > n) t.val[e] = -1.0;
+    const Reference ref_t = reference(t.dense()), ref_z = reference(z.dense());
+    if (ref_t.min_abs_eig < 1e-12 * ref_t.max_abs_eig ||
+        ref_z.min_abs_eig < 1e-12 * ref_z.max_abs_eig)
+      continue;
+    Ma27 solver(t, FESD_KKT_SPARSE);
+    const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(t.n, -1, 2);
+    ASSERT_EQ(solver.factor(t.val), 0) << "trial " << trial;
+    const Eigen::VectorXd x1 = solver.solve(b);
+    const long long before = delayed_pivots();
+    ASSERT_EQ(solver.factor(z.val), 0) << "trial " << trial;
+    if (delayed_pivots() > before) ++with_delays;
+    EXPECT_EQ(solver.negative(), ref_z.negative) << "trial " << trial;
+    EXPECT_LT(backward_error(z.dense(), solver.solve(b), b), 1e-14) << "trial " << trial;
+    ASSERT_EQ(solver.factor(t.val), 0) << "trial " << trial;
+    EXPECT_EQ(solver.negative(), ref_t.negative) << "trial " << trial;
+    EXPECT_EQ(solver.solve(b), x1) << "trial " << trial;
+  }
+  EXPECT_GE(with_delays, 6);
 }
 
 TEST(SparseLdl, TwoStructuresAliveAtOnce) {

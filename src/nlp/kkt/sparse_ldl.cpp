@@ -88,7 +88,9 @@ enum Header {
   kHMaxFront,  // largest front
   kHSymbolic,  // offset of the symbolic analysis (layout: Symbolic)
   kHEntries,   // entries of the permuted lower triangle (duplicates kept)
-  kHSupernodes
+  kHSupernodes,
+  kHFrontRows,  // sum of the supernodes' front sizes without delayed pivots
+  kHEdgeRows    // sum of the children's contribution rows without delayed pivots
 };
 // IKEEP[2N + 1 ..]: the symbolic analysis in IW is valid for this IW (address and length), so the
 // next factorization reuses it. IPOPT keeps IW between factorizations unless it reallocates it,
@@ -107,11 +109,25 @@ struct Symbolic {
   const int* sparent;   // ns: parent supernode, -1 at a root
   const int* cptr;      // ns + 1: each supernode's children ...
   const int* clist;     //   ... in increasing order
+  // Each supernode's front as it is without delayed pivots (the static front), kept so that a
+  // factorization builds no index lists: the rows, original numbering, own columns first
+  // (elimination order), then the others ascending in elimination order ...
+  const int* fptr;   // ns + 1
+  const int* frows;  //   ... (the delayed pivots of a factorization go between the two parts);
+  const int* amap;   // entries: static front position of crow[p] (column p's own front)
+  const int* eptr;   // clist entries + 1: per child (clist order), the static front positions in
+  const int* emap;   //   its parent of its contribution rows other than delayed pivots
   int ns = 0;
 };
 
-Index symbolic_length(int n, int nz, int entries, int ns) {
-  return static_cast<Index>(n) * 3 + 1 + entries + nz + 3 * static_cast<Index>(ns) + 2 + ns;
+Index symbolic_length(int n, int nz, int entries, int ns, int front_rows, int edge_rows) {
+  return static_cast<Index>(n) * 3 + 1 + entries + nz + 3 * static_cast<Index>(ns) + 2 + ns +
+         (static_cast<Index>(ns) + 1 + front_rows) + entries + (static_cast<Index>(ns) + edge_rows);
+}
+
+Index symbolic_length(const int* iw) {
+  return symbolic_length(iw[kHN], iw[kHNz], iw[kHEntries], iw[kHSupernodes], iw[kHFrontRows],
+                         iw[kHEdgeRows]);
 }
 
 Symbolic symbolic_view(const int* iw) {
@@ -135,6 +151,16 @@ Symbolic symbolic_view(const int* iw) {
   v.cptr = q;
   q += ns + 1;
   v.clist = q;
+  q += iw[kHSupernodes] > 0 ? v.cptr[ns] : 0;
+  v.fptr = q;
+  q += ns + 1;
+  v.frows = q;
+  q += iw[kHFrontRows];
+  v.amap = q;
+  q += entries;
+  v.eptr = q;
+  q += (ns > 0 ? v.cptr[ns] : 0) + 1;
+  v.emap = q;
   v.ns = ns;
   return v;
 }
@@ -252,6 +278,13 @@ void compute_ordering(int n, int nz, const int* irn, const int* icn, const doubl
   }
 }
 
+/// Makes v at least n long. Scratch vectors only grow: resizing one down and up again zero-filled
+/// it every time (a memset per front for the contribution blocks).
+template <class T>
+void grow(std::vector<T>& v, std::size_t n) {
+  if (v.size() < n) v.resize(n);
+}
+
 /// Rows of a front's column in storage: nf rounded up to a multiple of 4, so the vector kernels
 /// need no remainder loops (the padding rows stay zero).
 inline int front_ld(int nf) {
@@ -307,6 +340,20 @@ FESD_KKT_INLINE void store4(double* p, Vec4 v) {
   __builtin_memcpy(p, &v, sizeof v);
 }
 
+/// Zeroes what the kernels read of a front: column j from row (j rounded down to a multiple of 4)
+/// - 4 to the padded end (the kernels' vector loops start up to 7 rows above a diagonal). Half
+/// the stores of a memset of the whole front. Kept a loop of stores (GCC's loop distribution would
+/// make it a memset call per column).
+[[gnu::noinline, gnu::optimize("no-tree-loop-distribute-patterns")]] void zero_front(double* f,
+                                                                                     int nf) {
+  const int ld = front_ld(nf);
+  const Vec4 zero = {};
+  for (int j = 0; j < nf; ++j) {
+    double* c = f + static_cast<std::size_t>(j) * ld;
+    for (int i = std::max(0, (j & ~3) - 4); i < ld; i += 4) store4(c + i, zero);
+  }
+}
+
 /// C(:, j0 .. j0 + NB) -= L W for a front's contribution columns j0 .. j0 + NB: L = the front's
 /// first k columns, W = (D L') (row t at w + t ldw). Rows four at a time, from j0 rounded down to
 /// a multiple of 4 to the padded end of the column, with NB vector accumulators over all k pivots,
@@ -338,7 +385,7 @@ FESD_KKT_KERNEL void update_contribution(int nf, int nfs, int k, double* f, cons
   const std::size_t lds = static_cast<std::size_t>(ld);
   // W = D L21' (k x m, by rows): row t is pivot t's column of L below the fully summed rows
   // times D.
-  wbuf.resize(static_cast<std::size_t>(k) * m);
+  grow(wbuf, static_cast<std::size_t>(k) * m);
   double* w = wbuf.data();
   for (int t = 0; t < k;) {
     const double* lt = f + t * lds + nfs;
@@ -380,6 +427,46 @@ FESD_KKT_INLINE double dot(const double* x, const double* y, int from, int to) {
   return s;
 }
 
+/// max |x(i)| over i = from .. ld (ld a multiple of 4), vectorized from the next multiple of 4.
+FESD_KKT_INLINE double abs_max(const double* x, int from, int ld) {
+  using Bits = long long __attribute__((vector_size(32)));
+  double m = 0.0;
+  int i = from;
+  for (; i < ld && (i & 3) != 0; ++i) m = std::max(m, std::abs(x[i]));
+  if (i < ld) {
+    constexpr long long kMagnitude = 0x7fffffffffffffffLL;  // all bits but the sign
+    const Bits magnitude = {kMagnitude, kMagnitude, kMagnitude, kMagnitude};
+    Vec4 acc = {};
+    for (; i < ld; i += 4) {
+      const Vec4 v = reinterpret_cast<Vec4>(reinterpret_cast<Bits>(load4(x + i)) & magnitude);
+      acc = acc > v ? acc : v;
+    }
+    m = std::max({m, acc[0], acc[1], acc[2], acc[3]});
+  }
+  return m;
+}
+
+/// w(i) = c(i), c(i) = c(i) / d for i = from .. nf; w(i) = c(i) for i = nf .. ld (padding).
+/// Vector divisions round as scalar ones.
+FESD_KKT_INLINE void copy_and_scale(double* w, double* c, double d, int from, int nf, int ld) {
+  int i = from;
+  for (; i < nf && (i & 3) != 0; ++i) {
+    w[i] = c[i];
+    c[i] = w[i] / d;
+  }
+  const Vec4 dv = {d, d, d, d};
+  for (; i + 4 <= nf; i += 4) {
+    const Vec4 x = load4(c + i);
+    store4(w + i, x);
+    store4(c + i, x / dv);
+  }
+  for (; i < nf; ++i) {
+    w[i] = c[i];
+    c[i] = w[i] / d;
+  }
+  for (; i < ld; ++i) w[i] = c[i];
+}
+
 struct PivotResult {
   int nelim = 0;
   int negative = 0;
@@ -396,34 +483,35 @@ FESD_KKT_KERNEL PivotResult partial_ldlt(int nf, int nfs, double* storage, int* 
   Front F(storage, nf);
   const int ld = front_ld(nf);
   PivotResult res;
-  w1.resize(ld);
-  w2.resize(ld);
+  grow(w1, ld);
+  grow(w2, ld);
   int k = 0;
   while (k < nfs) {
     int pivot_p = -1, pivot_q = -1;
     for (int p = k; p < nfs && pivot_p < 0; ++p) {
-      double cmax = 0.0, qmax = 0.0;
+      // The column maximum first (vectorized); the 2x2 partner only if the 1x1 test fails.
+      double cmax = abs_max(F.col(p), p + 1, ld);
+      for (int i = k; i < p; ++i) cmax = std::max(cmax, std::abs(F.at(p, i)));
+      const double app = F.at(p, p);
+      if (std::abs(app) > tiny && std::abs(app) >= u * cmax) {
+        pivot_p = p;
+        break;
+      }
+      double qmax = 0.0;
       int q = -1;
       for (int i = k; i < p; ++i) {
         const double v = std::abs(F.at(p, i));
-        cmax = std::max(cmax, v);
         if (v > qmax) {
           qmax = v;
           q = i;
         }
       }
-      for (int i = p + 1; i < nf; ++i) {
+      for (int i = p + 1; i < nfs; ++i) {
         const double v = std::abs(F.at(i, p));
-        cmax = std::max(cmax, v);
-        if (i < nfs && v > qmax) {
+        if (v > qmax) {
           qmax = v;
           q = i;
         }
-      }
-      const double app = F.at(p, p);
-      if (std::abs(app) > tiny && std::abs(app) >= u * cmax) {
-        pivot_p = p;
-        break;
       }
       if (q < 0 || qmax <= tiny) continue;
       // 2x2 candidate (p, q): column maxima outside the block, then |D^-1| [cp; cq] <= 1/u.
@@ -449,13 +537,13 @@ FESD_KKT_KERNEL PivotResult partial_ldlt(int nf, int nfs, double* storage, int* 
       const double d = F.at(k, k);
       if (d < 0) ++res.negative;
       double* wk = w1.data();
-      // Rows (k + 1) & ~3 .. k of wk keep what they held: axpy_down adds them only to the unused
-      // upper triangle.
-      for (int i = k + 1; i < ld; ++i) wk[i] = F.at(i, k);  // padding rows: zero
-      // Fully summed columns now; the contribution block gets one update at the end.
-      for (int j = k + 1; j < nfs; ++j) axpy_down(F.col(j), wk, wk[j] / d, j, ld);
       double* ck = F.col(k);
-      for (int i = k + 1; i < nf; ++i) ck[i] = wk[i] / d;
+      // wk = column k below the pivot (padding rows: zero), column k = L = wk / d. Rows
+      // (k + 1) & ~3 .. k of wk keep what they held: axpy_down adds them only to the unused upper
+      // triangle.
+      copy_and_scale(wk, ck, d, k + 1, nf, ld);
+      // Fully summed columns now; the contribution block gets one update at the end.
+      for (int j = k + 1; j < nfs; ++j) axpy_down(F.col(j), wk, ck[j], j, ld);
       kind[k] = 1;
       k += 1;
     } else {
@@ -497,12 +585,18 @@ FESD_KKT_KERNEL PivotResult partial_ldlt(int nf, int nfs, double* storage, int* 
   return res;
 }
 
-/// Contribution block a front passes to its parent: indices (permuted numbering), the first
-/// ndelayed of them delayed pivots, and the lower triangle (column-major m x m).
+/// Contribution block a front passes to its parent: the lower triangle (column-major m x m) of its
+/// rows, the first ndelayed of them delayed pivots (their indices in idx), the others the static
+/// front's rows below the fully summed ones (the parent's position map, Symbolic::emap, has them).
 struct Contribution {
-  std::vector<int> idx;
+  std::vector<int> idx;  // the delayed pivots (original numbering)
   std::vector<double> val;
   int ndelayed = 0;
+  int m = 0;  // rows of the block
+  /// The block's first entry and leading dimension: in val (m), or in the front buffer it was
+  /// computed in when the parent is the next front.
+  const double* block = nullptr;
+  int ldb = 0;
 };
 
 /// Scratch memory of the factorization, kept per thread between calls (it holds no state: every
@@ -510,8 +604,8 @@ struct Contribution {
 /// ~3000-row KKT matrix: glibc returned the freed memory to the kernel and the next call paid
 /// page faults again.
 struct Workspace {
-  std::vector<double> rmax, cval, front, w1, w2;
-  std::vector<int> pos, fidx, kind, lp;
+  std::vector<double> rmax, cval, front[2], w1, w2;
+  std::vector<int> fidx, kind, lp;
   std::vector<Contribution> cb;
   std::vector<std::vector<double>> pool;
 };
@@ -523,7 +617,8 @@ struct Workspace {
 }
 
 /// Applies the factor to v in place: v <- S (L D L')^-1 S v.
-FESD_KKT_KERNEL void apply_inverse(const double* a, const int* iw, double* v, double* w) {
+FESD_KKT_KERNEL void apply_inverse(const double* __restrict a, const int* __restrict iw,
+                                   double* __restrict v, double* __restrict w) {
   const int n = iw[kHN], nz = iw[kHNz];
   const double* scale = a + nz;
   for (int i = 0; i < n; ++i) v[i] *= scale[i];
@@ -653,7 +748,8 @@ void sparse_analyse(int n, int nz, const int* irn, const int* icn, int* ikeep, i
   // The relaxed supernodes store each front's pivot block square and pad chains: twice AMD's
   // count plus a margin; a factorization that needs more reports IFLAG = -4 and IPOPT grows A.
   const double la = nz + n + 2.0 * lnz + 20.0 * n + 1000.0;
-  const double liw = kHeader + 2.0 * nz + 4.0 * n + lnz + 1000.0;
+  // IW: pattern, symbolic analysis with the static fronts (their rows and position maps), records.
+  const double liw = kHeader + 3.0 * nz + 8.0 * n + 2.0 * lnz + 1000.0;
   const double cap = static_cast<double>(std::numeric_limits<int>::max() / 8);
   info[4] = static_cast<int>(std::min(la, cap));   // NRLNEC
   info[5] = static_cast<int>(std::min(liw, cap));  // NIRNEC
@@ -790,15 +886,62 @@ Index build_symbolic(int n, int nz, const int* irn, const int* icn, const int* p
       if (sparent[s] >= 0) clist[next[sparent[s]]++] = s;
   }
 
+  // Static fronts (no delayed pivots): rows, the original entries' positions and the children's
+  // contribution rows' positions, so that a factorization neither builds index lists nor sorts.
+  // Children before parents (a supernode's number is its last column's rank).
   const int entries = colptr[n];
-  const Index need = symbolic_length(n, nz, entries, ns);
+  std::vector<int> fptr(static_cast<std::size_t>(ns) + 1, 0), frows, amap(entries),
+      eptr(static_cast<std::size_t>(cptr[ns]) + 1, 0), emap;
+  {
+    std::vector<int> fpos(n, -1);
+    for (int s = 0; s < ns; ++s) {
+      const int start = static_cast<int>(frows.size());
+      const auto add = [&](int g) {
+        if (fpos[g] >= 0) return;
+        fpos[g] = 0;
+        frows.push_back(g);
+      };
+      const int nown = cols_ptr[s + 1] - cols_ptr[s];
+      for (int t = 0; t < nown; ++t) add(cols[cols_ptr[s] + t]);
+      for (int t = 0; t < nown; ++t) {
+        const int c = cols[cols_ptr[s] + t];
+        for (int p = colptr[c]; p < colptr[c + 1]; ++p) add(crow[p]);
+      }
+      for (int p = cptr[s]; p < cptr[s + 1]; ++p) {
+        const int ch = clist[p];
+        const int ch_own = cols_ptr[ch + 1] - cols_ptr[ch];
+        for (int i = fptr[ch] + ch_own; i < fptr[ch + 1]; ++i) add(frows[i]);
+      }
+      std::sort(frows.begin() + start + nown, frows.end());
+      const int end = static_cast<int>(frows.size());
+      for (int i = start; i < end; ++i) fpos[frows[i]] = i - start;
+      for (int t = 0; t < nown; ++t) {
+        const int c = cols[cols_ptr[s] + t];
+        for (int p = colptr[c]; p < colptr[c + 1]; ++p) amap[p] = fpos[crow[p]];
+      }
+      for (int p = cptr[s]; p < cptr[s + 1]; ++p) {
+        const int ch = clist[p];
+        const int ch_own = cols_ptr[ch + 1] - cols_ptr[ch];
+        for (int i = fptr[ch] + ch_own; i < fptr[ch + 1]; ++i) emap.push_back(fpos[frows[i]]);
+        eptr[p + 1] = static_cast<int>(emap.size());
+      }
+      for (int i = start; i < end; ++i) fpos[frows[i]] = -1;
+      fptr[s + 1] = end;
+    }
+  }
+  for (int& g : frows) g = perm[g];
+
+  const int front_rows = static_cast<int>(frows.size()), edge_rows = static_cast<int>(emap.size());
+  const Index need = symbolic_length(n, nz, entries, ns, front_rows, edge_rows);
   if (iw_at + need > liw) return iw_at + need;
   iw[kHSymbolic] = static_cast<int>(iw_at);
   iw[kHEntries] = entries;
   iw[kHSupernodes] = ns;
+  iw[kHFrontRows] = front_rows;
+  iw[kHEdgeRows] = edge_rows;
   int* q = iw + iw_at;
-  for (const std::vector<int>* v :
-       {&iperm, &colptr, &crow, &slot, &cols_ptr, &cols, &sparent, &cptr, &clist})
+  for (const std::vector<int>* v : {&iperm, &colptr, &crow, &slot, &cols_ptr, &cols, &sparent,
+                                    &cptr, &clist, &fptr, &frows, &amap, &eptr, &emap})
     q = std::copy(v->begin(), v->end(), q);
   return iw_at + need;
 }
@@ -863,10 +1006,9 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
     }
   }
   const Symbolic sym = symbolic_view(iw);
-  const Index fixed_liw = iw[kHSymbolic] + symbolic_length(n, nz, iw[kHEntries], sym.ns);
+  const Index fixed_liw = iw[kHSymbolic] + symbolic_length(iw);
   iw[kHFirst] = iw[kHEnd] = static_cast<int>(fixed_liw);
-  const int* perm = ikeep;
-  const int *colptr = sym.colptr, *crow = sym.crow, *cols_ptr = sym.cols_ptr, *cols = sym.cols,
+  const int *colptr = sym.colptr, *cols_ptr = sym.cols_ptr, *cols = sym.cols,
             *sparent = sym.sparent, *cptr = sym.cptr, *clist = sym.clist;
   const int ns = sym.ns;
 
@@ -881,36 +1023,50 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
     rmax.resize(n);
     // The pattern in IW: 0-based, -1 for out-of-range entries.
     const int *prow = iw + kHeader, *pcol = prow + nz;
-    for (int sweep = 0; sweep < 3; ++sweep) {
+    // Every triplet in range (the usual case): no per-entry test. The first sweep has scale = 1.
+    const bool all_valid = iw[kHEntries] == nz;
+    const auto sweep = [&]<bool kChecked, bool kFirst>() {
       std::fill(rmax.begin(), rmax.end(), 0.0);
       for (int e = 0; e < nz; ++e) {
         const int i = prow[e], j = pcol[e];
-        if (i < 0) continue;
-        const double v = std::abs(a[e]) * scale[i] * scale[j];
+        if (kChecked && i < 0) continue;
+        const double v = kFirst ? std::abs(a[e]) : std::abs(a[e]) * scale[i] * scale[j];
         rmax[i] = std::max(rmax[i], v);
         rmax[j] = std::max(rmax[j], v);
       }
       for (int i = 0; i < n; ++i) scale[i] *= inverse_sqrt_pow2(rmax[i]);
+    };
+    if (all_valid) {
+      sweep.template operator()<false, true>();
+      sweep.template operator()<false, false>();
+      sweep.template operator()<false, false>();
+    } else {
+      sweep.template operator()<true, true>();
+      sweep.template operator()<true, false>();
+      sweep.template operator()<true, false>();
     }
   }
 
   // Scaled values in the permuted lower triangle.
   std::vector<double>& cval = ws.cval;
-  cval.assign(static_cast<std::size_t>(iw[kHEntries]), 0.0);
+  grow(cval, static_cast<std::size_t>(iw[kHEntries]));  // every entry is written below
   double amax = 0.0;
-  for (int e = 0; e < nz; ++e) {
-    if (sym.slot[e] < 0) continue;
-    const double v = a[e] * scale[irn[e] - 1] * scale[icn[e] - 1];
-    amax = std::max(amax, std::abs(v));
-    cval[sym.slot[e]] = v;
+  {
+    const int *prow = iw + kHeader, *pcol = prow + nz;
+    for (int e = 0; e < nz; ++e) {
+      const int i = prow[e];
+      if (i < 0) continue;
+      const double v = a[e] * scale[i] * scale[pcol[e]];
+      amax = std::max(amax, std::abs(v));
+      cval[sym.slot[e]] = v;
+    }
   }
   const double tiny = kTinyRel * std::max(amax, std::numeric_limits<double>::min());
   const double u = std::clamp(pivtol, kMinPivtol, kMaxPivtol);
 
   // Multifrontal factorization; children (smaller last columns) come before their parent.
-  std::vector<int>&pos = ws.pos, &fidx = ws.fidx, &kind = ws.kind;
-  pos.assign(n, -1);
-  std::vector<double>&front = ws.front, &w1 = ws.w1, &w2 = ws.w2;
+  std::vector<int>&fidx = ws.fidx, &kind = ws.kind;
+  std::vector<double>&w1 = ws.w1, &w2 = ws.w2;
   std::vector<int>& w_pos = ws.lp;
   std::vector<Contribution>& cb = ws.cb;
   std::vector<std::vector<double>>& pool = ws.pool;
@@ -919,9 +1075,9 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
   if (cb.size() < static_cast<std::size_t>(ns)) cb.resize(ns);
   const auto release = [&pool](Contribution& c) {
     if (c.val.capacity() > 0) pool.push_back(std::move(c.val));
-    c.val.clear();
     c.idx.clear();
     c.ndelayed = 0;
+    c.m = 0;
   };
   for (int s = 0; s < ns; ++s) release(cb[s]);
   Index a_next = fixed_la, iw_next = fixed_liw;
@@ -931,65 +1087,80 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
   for (int s = 0; s < ns; ++s) {
     const int* own = cols + cols_ptr[s];
     const int nown = cols_ptr[s + 1] - cols_ptr[s];
-    fidx.clear();
-    auto add = [&](int g) {
-      if (pos[g] >= 0) return;
-      pos[g] = static_cast<int>(fidx.size());
-      fidx.push_back(g);
-    };
-    for (int t = 0; t < nown; ++t) add(own[t]);
-    for (int p = cptr[s]; p < cptr[s + 1]; ++p) {
-      const Contribution& ch = cb[clist[p]];
-      for (int t = 0; t < ch.ndelayed; ++t) add(ch.idx[t]);
+    const int* srows = sym.frows + sym.fptr[s];
+    const int nf0 = sym.fptr[s + 1] - sym.fptr[s];
+    // Front order (original numbering): own columns, the children's delayed pivots (children in
+    // order), then the static front's other rows; a static position sp >= nown moves down by nd.
+    int nd = 0;
+    for (int p = cptr[s]; p < cptr[s + 1]; ++p) nd += cb[clist[p]].ndelayed;
+    const int nfs = nown + nd, nf = nf0 + nd;
+    fidx.resize(nf);
+    std::copy_n(srows, nown, fidx.begin());
+    {
+      int at = nown;
+      for (int p = cptr[s]; p < cptr[s + 1]; ++p) {
+        const Contribution& ch = cb[clist[p]];
+        at = static_cast<int>(std::copy_n(ch.idx.begin(), ch.ndelayed, fidx.begin() + at) -
+                              fidx.begin());
+      }
     }
-    const int nfs = static_cast<int>(fidx.size());
-    for (int t = 0; t < nown; ++t)
-      for (int p = colptr[own[t]]; p < colptr[own[t] + 1]; ++p) add(crow[p]);
-    for (int p = cptr[s]; p < cptr[s + 1]; ++p)
-      for (int g : cb[clist[p]].idx) add(g);
-    const int nf = static_cast<int>(fidx.size());
-    // Front order: own columns ascending, delayed pivots, then the other rows ascending. A child's
-    // rows other than its delayed ones are ascending too, so they land in ascending positions:
-    // the extend-add below needs no per-entry triangle test for them.
-    std::sort(fidx.begin() + nfs, fidx.end());
-    for (int i = nfs; i < nf; ++i) pos[fidx[i]] = i;
+    std::copy(srows + nown, srows + nf0, fidx.begin() + nfs);
     maxnf = std::max(maxnf, nf);
     const int ld = front_ld(nf);
-    if (front.size() < static_cast<std::size_t>(ld) * nf)
-      front.resize(static_cast<std::size_t>(ld) * nf);
+    // Fronts alternate between two buffers: a front whose parent comes next leaves its
+    // contribution block in place, and the parent reads it from there (no copy).
+    std::vector<double>& front = ws.front[s & 1];
+    grow(front, static_cast<std::size_t>(ld) * nf);
     double* fr = front.data();
-    // One memset of the whole front: zeroing only the lower triangle took a memset call per
-    // column (GCC turns the loop into one), more than the stores for these short columns.
-    std::memset(fr, 0, sizeof(double) * static_cast<std::size_t>(ld) * nf);
+    zero_front(fr, nf);
+    const auto shifted = [nown, nd](int sp) { return sp >= nown ? sp + nd : sp; };
     for (int t = 0; t < nown; ++t) {
       const int c = own[t];
-      double* fc = fr + static_cast<std::size_t>(pos[c]) * ld;
-      for (int p = colptr[c]; p < colptr[c + 1]; ++p) fc[pos[crow[p]]] += cval[p];
+      double* fc = fr + static_cast<std::size_t>(t) * ld;
+      if (nd == 0)
+        for (int p = colptr[c]; p < colptr[c + 1]; ++p) fc[sym.amap[p]] += cval[p];
+      else
+        for (int p = colptr[c]; p < colptr[c + 1]; ++p) fc[shifted(sym.amap[p])] += cval[p];
     }
+    int delayed_at = nown;
     for (int p = cptr[s]; p < cptr[s + 1]; ++p) {
       Contribution& ch = cb[clist[p]];
-      const int m = static_cast<int>(ch.idx.size());
-      std::vector<int>& lp = w_pos;
-      lp.resize(m);
-      for (int b = 0; b < m; ++b) lp[b] = pos[ch.idx[b]];
-      for (int jb = 0; jb < m; ++jb) {
-        const int pj = lp[jb];
-        const double* col = ch.val.data() + static_cast<std::size_t>(jb) * m;
-        if (jb < ch.ndelayed) {
-          for (int ib = jb; ib < m; ++ib) {
-            const int pi = lp[ib];
-            const auto at = pi >= pj ? static_cast<std::size_t>(pj) * ld + pi
-                                     : static_cast<std::size_t>(pi) * ld + pj;
-            fr[at] += col[ib];
+      const int m = ch.m, chd = ch.ndelayed;
+      const int* map = sym.emap + sym.eptr[p];
+      if (nd == 0) {
+        // No delayed pivots (chd = 0 too): the static map as it is, no triangle test. (Vector adds
+        // for runs of consecutive positions, precomputed: as many instructions, no faster.)
+        for (int jb = 0; jb < m; ++jb) {
+          const double* col = ch.block + static_cast<std::size_t>(jb) * ch.ldb;
+          double* fc = fr + static_cast<std::size_t>(map[jb]) * ld;
+          for (int ib = jb; ib < m; ++ib) fc[map[ib]] += col[ib];
+        }
+      } else {
+        // Positions of the child's rows in this front: its delayed pivots, then its static rows.
+        w_pos.resize(m);
+        for (int b = 0; b < chd; ++b) w_pos[b] = delayed_at + b;
+        for (int b = chd; b < m; ++b) w_pos[b] = shifted(map[b - chd]);
+        delayed_at += chd;
+        const int* lp = w_pos.data();
+        for (int jb = 0; jb < m; ++jb) {
+          const int pj = lp[jb];
+          const double* col = ch.block + static_cast<std::size_t>(jb) * ch.ldb;
+          if (jb < chd) {
+            for (int ib = jb; ib < m; ++ib) {
+              const int pi = lp[ib];
+              const auto at = pi >= pj ? static_cast<std::size_t>(pj) * ld + pi
+                                       : static_cast<std::size_t>(pi) * ld + pj;
+              fr[at] += col[ib];
+            }
+          } else {
+            double* fc = fr + static_cast<std::size_t>(pj) * ld;
+            for (int ib = jb; ib < m; ++ib) fc[lp[ib]] += col[ib];
           }
-        } else {
-          double* fc = fr + static_cast<std::size_t>(pj) * ld;
-          for (int ib = jb; ib < m; ++ib) fc[lp[ib]] += col[ib];
         }
       }
       release(ch);
     }
-    kind.assign(nf, 0);
+    grow(kind, nf);
     const PivotResult pr =
         partial_ldlt(nf, nfs, front.data(), fidx.data(), kind.data(), u, tiny, w1, w2);
     const int ne = pr.nelim;
@@ -1004,7 +1175,7 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
       rec[0] = nf;
       rec[1] = ne;
       rec[2] = static_cast<int>(a_next);
-      for (int i = 0; i < nf; ++i) rec[3 + i] = perm[fidx[i]];
+      std::copy_n(fidx.data(), nf, rec + 3);
       std::copy_n(kind.data(), ne, rec + 3 + nf);
       rec[3 + nf + ne] = static_cast<int>(iw_next);
     }
@@ -1019,20 +1190,29 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
         singular = true;
         rank -= m;
       } else {
+        // The block's rows: the pivots delayed to the parent (indices kept), then the static
+        // front's rows below the fully summed ones (the parent's emap has their positions).
         Contribution& out = cb[s];
-        out.idx.assign(fidx.begin() + ne, fidx.end());
+        out.idx.assign(fidx.begin() + ne, fidx.begin() + nfs);
         out.ndelayed = nfs - ne;
-        if (!pool.empty()) {
-          out.val = std::move(pool.back());
-          pool.pop_back();
+        out.m = m;
+        if (sparent[s] == s + 1) {  // in place (the next front uses the other buffer)
+          out.block = fr + static_cast<std::size_t>(ne) * ld + ne;
+          out.ldb = ld;
+        } else {
+          if (!pool.empty()) {
+            out.val = std::move(pool.back());
+            pool.pop_back();
+          }
+          grow(out.val, static_cast<std::size_t>(m) * m);
+          for (int j = 0; j < m; ++j)  // lower triangle
+            std::copy_n(fr + static_cast<std::size_t>(ne + j) * ld + ne + j, m - j,
+                        out.val.data() + static_cast<std::size_t>(j) * m + j);
+          out.block = out.val.data();
+          out.ldb = m;
         }
-        out.val.resize(static_cast<std::size_t>(m) * m);
-        for (int j = 0; j < m; ++j)  // lower triangle
-          std::copy_n(fr + static_cast<std::size_t>(ne + j) * ld + ne + j, m - j,
-                      out.val.data() + static_cast<std::size_t>(j) * m + j);
       }
     }
-    for (int g : fidx) pos[g] = -1;
   }
   if (stats != nullptr) {
     stats->delayed_pivots += delayed;
@@ -1076,12 +1256,14 @@ void sparse_solve(int n, const double* a, const int* iw, double* w, double* rhs,
   apply_inverse(a, iw, rhs, work);
   double best_berr = std::numeric_limits<double>::infinity();
   // r = b - A x; the first pass also sums |A| by rows (bound), which later passes reuse.
-  const auto residual = [&]<bool kBound>() {
+  // Without the range test when every triplet is in range (the usual case).
+  const bool all_valid = iw[kHEntries] == nz;
+  const auto residual_pass = [&]<bool kBound, bool kChecked>() {
     std::copy_n(b, n, r);
     if (kBound) std::fill_n(bound, n, 0.0);
     for (int e = 0; e < nz; ++e) {
       const int i = irn[e], j = icn[e];
-      if (i < 0) continue;
+      if (kChecked && i < 0) continue;
       r[i] -= a[e] * rhs[j];
       if (kBound) bound[i] += std::abs(a[e]);
       if (i != j) {
@@ -1089,6 +1271,12 @@ void sparse_solve(int n, const double* a, const int* iw, double* w, double* rhs,
         if (kBound) bound[j] += std::abs(a[e]);
       }
     }
+  };
+  const auto residual = [&]<bool kBound>() {
+    if (all_valid)
+      residual_pass.template operator()<kBound, false>();
+    else
+      residual_pass.template operator()<kBound, true>();
   };
   double anorm = 0.0, bnorm = 0.0;
   for (int it = 0;; ++it) {
