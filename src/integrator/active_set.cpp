@@ -83,6 +83,7 @@ ActiveSetStep::ActiveSetStep(const Pss& model, const Tableau& tab, const Discret
 bool ActiveSetStep::solve(const Eigen::VectorXd& x0, const std::vector<int>& predicted,
                           const dcs::LpSolution& lp, const Eigen::VectorXd& xdot) {
   iterations_ = tries_ = 0;
+  kind_ = Kind::Prediction;
   fix(nlp_, in_.s0, x0);
   w_ = nlp_.x_init;
   for (int r = 0; r < model_.n_theta(); ++r) w_[in_.lambda_start[r]] = lp.lambda[r];
@@ -96,33 +97,69 @@ bool ActiveSetStep::solve(const Eigen::VectorXd& x0, const std::vector<int>& pre
   if (v.bad) return false;
   if (v.r < 0) return true;
 
-  // A switch inside the step: region v.r enters. Its time from lambda_r, linear between the last
-  // point where lambda_r >= 0 held and the first where it failed.
-  const double ts = v.t_ok + (v.t_bad - v.t_ok) * v.lam_ok / std::max(v.lam_ok - v.lam_bad, 1e-300);
-  // A crossing: r replaces the active regions of its subsystem. (Entering a sliding mode, r added
-  // to them, is left to the homotopy for now: tried as a second candidate it accepted a spurious
-  // sliding solution of examples/temperature_control.toml, where the homotopy crosses.)
+  // A switch inside the step: region v.r enters (v.exit: leaves). Its time from lambda_r (theta_r),
+  // linear between the last point where the sign held and the first where it failed.
+  const double ts = v.t_ok + (v.t_bad - v.t_ok) * v.val_ok / std::max(v.val_ok - v.val_bad, 1e-300);
   const int k = subsystem_of(model_, v.r);
-  std::vector<int> crossing;
-  for (int r : predicted)
-    if (subsystem_of(model_, r) != k) crossing.push_back(r);
-  crossing.push_back(v.r);
-  std::sort(crossing.begin(), crossing.end());
+  std::vector<Candidate> candidates;
+  if (v.exit) {
+    // Leaving a sliding mode: r leaves the set; at the boundary b theta_r = 0 (the pin of
+    // FesdInterval::pin_bounds) replaces h_b = h_{b-1}. b = 0: the whole step without r.
+    std::vector<int> after = predicted;
+    std::erase(after, v.r);
+    for (int b : boundaries_for(ts))
+      if (b > 0 ? iv_->can_pin_exits() : true) candidates.push_back({Kind::Exit, after, b});
+  } else {
+    // A crossing: r replaces the active regions of its subsystem. Entering a sliding mode: r is
+    // added to them. Per boundary the crossing first; the sliding candidate is accepted only
+    // with theta strictly inside the simplex (sliding_is_filippov).
+    std::vector<int> crossing, sliding = predicted;
+    for (int r : predicted)
+      if (subsystem_of(model_, r) != k) crossing.push_back(r);
+    crossing.push_back(v.r);
+    std::sort(crossing.begin(), crossing.end());
+    sliding.push_back(v.r);
+    std::sort(sliding.begin(), sliding.end());
+    for (int b : boundaries_for(ts)) {
+      candidates.push_back({Kind::Crossing, crossing, b});
+      candidates.push_back({Kind::SlidingEntry, sliding, b});
+    }
+  }
   const std::vector<double> w_pred = w_;
-  for (int b : boundaries_for(ts)) {
+  for (const Candidate& c : candidates) {
     if (tries_ >= kMaxTries) return false;
     Sets active = predicted_sets;
-    for (int n = b; n < iv_->N_FE(); ++n) active[n] = crossing;
-    switched_guess(w_pred, predicted, crossing, b, ts);
+    for (int n = c.b; n < iv_->N_FE(); ++n) active[n] = c.after;
+    switched_guess(w_pred, predicted, c.after, c.b, ts);
     ++tries_;
-    if (!newton(active).converged) continue;
+    const int pin = c.kind == Kind::Exit && c.b > 0 ? iv_->theta(c.b - 1, iv_->n_s() - 1, v.r) : -1;
+    if (!newton(active, pin).converged) continue;
     const Violation again = check_signs(active);
-    if (!again.bad && again.r < 0) return true;
+    if (again.bad || again.r >= 0) continue;
+    if (c.kind == Kind::SlidingEntry && !sliding_is_filippov(active, k, c.b)) continue;
+    kind_ = c.kind;
+    return true;
   }
   return false;
 }
 
-ActiveSetTry ActiveSetStep::newton(const Sets& active) {
+bool ActiveSetStep::sliding_is_filippov(const Sets& active, int k, int b) const {
+  // With the entering region r in the set, the sliding theta^k lies strictly inside the simplex
+  // at every stage after the entry: both fields point toward the surface (for two regions theta_r
+  // = grad c . f_a / grad c . (f_a - f_r) in (0, 1) iff the normal components have opposite
+  // signs, and f_a points toward the surface, since the state reached it). A theta at 0 (a field
+  // tangent to the surface, e.g. a Filippov equilibrium on it) is not accepted: the crossing
+  // failed, and the homotopy decides.
+  const discretization::FesdInterval& iv = *iv_;
+  for (int n = b; n < iv.N_FE(); ++n)
+    for (int s = 0; s < iv.n_s(); ++s)
+      for (int r : active[n])
+        if (subsystem_of(model_, r) == k && !(w_[iv.theta(n, s, r)] > kSlidingThetaTol))
+          return false;
+  return true;
+}
+
+ActiveSetTry ActiveSetStep::newton(const Sets& active, int pin) {
   const discretization::FesdInterval& iv = *iv_;
   const int N = iv.N_FE();
   lb_ = nlp_.x_lb;
@@ -131,6 +168,7 @@ ActiveSetTry ActiveSetStep::newton(const Sets& active) {
     lb_[bd.var] = bd.lb;
     ub_[bd.var] = bd.ub;
   }
+  if (pin >= 0) lb_[pin] = ub_[pin] = 0;  // a sliding exit: theta_r = 0 at the boundary
   free_.clear();
   col_of_.assign(lb_.size(), -1);
   for (std::size_t j = 0; j < lb_.size(); ++j) {
@@ -142,7 +180,8 @@ ActiveSetTry ActiveSetStep::newton(const Sets& active) {
     }
   }
   // h_n = h_{n-1} where the active set does not change; at a switch the boundary's length is
-  // free and the switch condition (lambda = 0 of both regions there, fixed above) takes its row.
+  // free and the switch condition takes its row: lambda = 0 of both regions there (a crossing,
+  // a sliding entry; fixed above), or theta_r = 0 of the leaving region (an exit: the pin).
   std::vector<int> equal;
   for (int n = 1; n < N; ++n)
     if (active[n] == active[n - 1]) equal.push_back(n);
@@ -202,36 +241,47 @@ ActiveSetStep::Violation ActiveSetStep::check_signs(const Sets& active) const {
       v.bad = true;
       return v;
     }
-    for (int s = 0; s < n_s; ++s)
-      for (int r : active[n])
-        if (w_[iv.theta(n, s, r)] < -kSignTol) {
-          v.bad = true;  // a sliding exit: not handled by this path
-          return v;
-        }
   }
-  // lambda >= 0 off the active set, in time order; per region the last point where it held.
-  std::vector<double> t_ok(n_th, 0.0), lam_ok(n_th, 0.0);
+  // In time order: theta >= 0 on the active set (a failure in a sliding set is an exit of that
+  // region; in a set with one region of its subsystem theta is 1), lambda >= 0 off it (an entry);
+  // per region the last point where its sign held.
+  std::vector<double> t_ok(n_th, 0.0), val_ok(n_th, 0.0);
+  const auto violated = [&](int r, double t, double val, bool exit) {
+    v.r = r;
+    v.exit = exit;
+    v.t_ok = t_ok[r];
+    v.val_ok = val_ok[r];
+    v.t_bad = t;
+    v.val_bad = val;
+  };
   double t_n = 0;
   for (int n = 0; n < N; ++n) {
     const double hn = w_[iv.h(n)];
     const auto& points = iv.lambda_points(n);
     for (std::size_t q = 0; q < points.size(); ++q) {
-      if (!iv.point_signed(n, static_cast<int>(q))) continue;
       const int qi = static_cast<int>(q);
       const double t = q == 0 ? t_n : qi <= n_s ? t_n + tab_.c(qi - 1) * hn : t_n + hn;
+      if (qi >= 1 && qi <= n_s)
+        for (int r : active[n]) {
+          const double th = w_[iv.theta(n, qi - 1, r)];
+          if (th < -kSignTol) {
+            // the first stage of the step: no earlier point where it held (t_ok = 0, th_ok = 0)
+            violated(r, t, th, true);
+            return v;
+          }
+          t_ok[r] = t;
+          val_ok[r] = th;
+        }
+      if (!iv.point_signed(n, qi)) continue;
       for (int r = 0; r < n_th; ++r) {
         if (discretization::has(active[n], r)) continue;
         const double lam = w_[points[q][r]];
         if (lam < -kSignTol) {
-          v.r = r;
-          v.t_ok = t_ok[r];
-          v.lam_ok = lam_ok[r];
-          v.t_bad = t;
-          v.lam_bad = lam;
+          violated(r, t, lam, false);
           return v;
         }
         t_ok[r] = t;
-        lam_ok[r] = lam;
+        val_ok[r] = lam;
       }
     }
     t_n += hn;
@@ -241,6 +291,9 @@ ActiveSetStep::Violation ActiveSetStep::check_signs(const Sets& active) const {
 
 std::vector<int> ActiveSetStep::boundaries_for(double ts) const {
   const int N = iv_->N_FE();
+  // The sign failed at the step's first point: the switch is at its start (an exit of a region
+  // whose theta reached 0 at the end of the step before), not after an element of length 0.
+  if (ts <= 0) return {0};
   const double h0 = T_ / N, lo = nlp_.x_lb[iv_->h(0)], hi = nlp_.x_ub[iv_->h(0)];
   const auto within = [&](double h) { return h >= lo && h <= hi; };
   std::vector<std::pair<double, int>> cost;
@@ -269,6 +322,21 @@ void ActiveSetStep::switched_guess(const std::vector<double>& w_pred,
     if (!discretization::has(before, r)) in.push_back(r);
   for (int r : before)
     if (!discretization::has(after, r)) out.push_back(r);
+  if (in.empty() && out.size() == 1) {
+    // A sliding exit: theta of the leaving region is shared among the others of its subsystem.
+    const int r_out = out[0], k = subsystem_of(model_, r_out);
+    for (int n = b; n < N; ++n)
+      for (int s = 0; s < n_s; ++s) {
+        double rest = 0;
+        for (int r : after)
+          if (subsystem_of(model_, r) == k) rest += w_[iv.theta(n, s, r)];
+        const double scale = rest > 0 ? 1 / rest : 0;
+        for (int r : after)
+          if (subsystem_of(model_, r) == k) w_[iv.theta(n, s, r)] *= scale;
+        w_[iv.theta(n, s, r_out)] = 0;
+      }
+    return;
+  }
   if (in.size() != 1) return;
   const int r_in = in[0], k = subsystem_of(model_, r_in);
   const int r_out = out.size() == 1 ? out[0] : -1;

@@ -64,8 +64,15 @@ class ActiveSetStep {
   /// Size of the square system (per active-set shape; the last one solved).
   int system_size() const { return static_cast<int>(free_.size()); }
 
+  /// What the accepted solution of the last solve() is.
+  enum class Kind { Prediction, Crossing, SlidingEntry, Exit };
+  Kind kind() const { return kind_; }
+
   /// Square systems tried per step before the homotopy takes over.
-  static constexpr int kMaxTries = 4;
+  static constexpr int kMaxTries = 6;
+  /// A sliding entry is accepted only with every theta of the sliding subsystem above this at
+  /// every stage after the entry (strictly inside the simplex: sliding_is_filippov()).
+  static constexpr double kSlidingThetaTol = 1e-6;
   static constexpr int kMaxNewton = 25;
   /// Sign tolerance of theta >= 0, lambda >= 0 (a switch within ~kSignTol / |c'| of a step end
   /// is taken at the step end).
@@ -73,17 +80,29 @@ class ActiveSetStep {
 
  private:
   using Sets = std::vector<std::vector<int>>;
-  /// Newton's method from w_ with the active sets `active`; w_ is the result.
-  ActiveSetTry newton(const Sets& active);
-  /// The first violated lambda >= 0 (region r at time t_bad, the last time t_ok where it held),
-  /// or r = -1 if the signs hold; `bad` is set when a sign fails that no switch can repair
-  /// (theta < 0, h_n out of bounds).
+  /// Newton's method from w_ with the active sets `active` (and variable `pin` fixed to 0 if
+  /// >= 0: theta_r at the end of the element before a sliding exit); w_ is the result.
+  ActiveSetTry newton(const Sets& active, int pin = -1);
+  /// The first violated sign in time order, or r = -1 if the signs hold: lambda_r < 0 off the set
+  /// (a region entering, exit = false) or theta_r < 0 on it (a region leaving a sliding mode,
+  /// exit = true), at time t_bad, with value val_bad; t_ok, val_ok: the last point where that
+  /// region's sign held. `bad`: h_n out of bounds (no switch repairs it).
   struct Violation {
     int r = -1;
-    double t_ok = 0, t_bad = 0, lam_ok = 0, lam_bad = 0;
+    bool exit = false;
+    double t_ok = 0, t_bad = 0, val_ok = 0, val_bad = 0;
     bool bad = false;
   };
   Violation check_signs(const Sets& active) const;
+  /// The candidates tried after a failed prediction: elements from b on have the set `after`.
+  struct Candidate {
+    Kind kind;
+    std::vector<int> after;
+    int b = 0;
+  };
+  /// A sliding entry into subsystem k at boundary b is a Filippov sliding mode: theta^k strictly
+  /// inside its simplex at every stage from element b on (kSlidingThetaTol).
+  bool sliding_is_filippov(const Sets& active, int k, int b) const;
   /// Boundaries b (0..N_FE-1) where a switch at time ts can sit with every h_n within its bounds,
   /// best first (the least sum (h_n - T/N_FE)^2, the homotopy's heuristic_mean choice).
   std::vector<int> boundaries_for(double ts) const;
@@ -107,6 +126,7 @@ class ActiveSetStep {
   Eigen::VectorXd F_, dz_;
   std::vector<double> g_, jac_;
   int iterations_ = 0, tries_ = 0;
+  Kind kind_ = Kind::Prediction;
 };
 
 }  // namespace fesd::integrator
