@@ -80,7 +80,7 @@ ActiveSetStep::ActiveSetStep(const Pss& model, const Tableau& tab, const Discret
   jac_.resize(nlp_.jac_nnz());
 }
 
-bool ActiveSetStep::solve(const Eigen::VectorXd& x0, const std::vector<int>& predicted,
+bool ActiveSetStep::solve(const Eigen::VectorXd& x0, const std::vector<int>& prediction,
                           const dcs::LpSolution& lp, const Eigen::VectorXd& xdot) {
   iterations_ = tries_ = 0;
   kind_ = Kind::Prediction;
@@ -90,9 +90,21 @@ bool ActiveSetStep::solve(const Eigen::VectorXd& x0, const std::vector<int>& pre
   for (int k = 0; k < model_.n_sys(); ++k) w_[in_.mu_start[k]] = lp.mu[k];
   iv_->set_guess(w_, x0, lp, xdot);
 
+  // The prediction, then (if its system is not square or singular) the selections of a
+  // co-dimension-2 sliding mode (selections()).
+  std::vector<int> predicted;
+  const std::vector<double> w_guess = w_;
+  for (const std::vector<int>& set : selections(prediction, lp)) {
+    if (tries_ >= kMaxTries) return false;
+    w_ = w_guess;
+    ++tries_;
+    if (newton(Sets(iv_->N_FE(), set)).converged) {
+      predicted = set;
+      break;
+    }
+  }
+  if (predicted.empty()) return false;
   const Sets predicted_sets(iv_->N_FE(), predicted);
-  ++tries_;
-  if (!newton(predicted_sets).converged) return false;
   const Violation v = check_signs(predicted_sets);
   if (v.bad) return false;
   if (v.r < 0) return true;
@@ -101,28 +113,55 @@ bool ActiveSetStep::solve(const Eigen::VectorXd& x0, const std::vector<int>& pre
   // linear between the last point where the sign held and the first where it failed.
   const double ts = v.t_ok + (v.t_bad - v.t_ok) * v.val_ok / std::max(v.val_ok - v.val_bad, 1e-300);
   const int k = subsystem_of(model_, v.r);
+  // The predicted set with subsystem k's regions replaced by `regions_k` (sorted).
+  const auto with_k = [&](std::vector<int> regions_k) {
+    for (int r : predicted)
+      if (subsystem_of(model_, r) != k) regions_k.push_back(r);
+    std::sort(regions_k.begin(), regions_k.end());
+    return regions_k;
+  };
+  std::vector<int> active_k, off_k;
+  for (int r = model_.region_offset(k); r < model_.region_offset(k + 1); ++r)
+    (discretization::has(predicted, r) ? active_k : off_k).push_back(r);
   std::vector<Candidate> candidates;
   if (v.exit) {
     // Leaving a sliding mode: r leaves the set; at the boundary b theta_r = 0 (the pin of
-    // FesdInterval::pin_bounds) replaces h_b = h_{b-1}. b = 0: the whole step without r.
+    // FesdInterval::pin_bounds) replaces h_b = h_{b-1}. b = 0: the whole step without r. Then
+    // (co-dimension 2: the state leaves both surfaces at once) a region j off the set replacing
+    // the subsystem's regions after the pin, lambda_j at the boundary free (not a second switch
+    // condition: on the intersection lambda_j = 0 holds whatever the boundary's time).
     std::vector<int> after = predicted;
     std::erase(after, v.r);
-    for (int b : boundaries_for(ts))
-      if (b > 0 ? iv_->can_pin_exits() : true) candidates.push_back({Kind::Exit, after, b});
+    for (int b : boundaries_for(ts)) {
+      if (b > 0 && !iv_->can_pin_exits()) continue;
+      candidates.push_back({Kind::Exit, after, b});
+      if (b > 0 && active_k.size() > 2)
+        for (int j : off_k) candidates.push_back({Kind::Exit, with_k({j}), b, j});
+    }
   } else {
     // A crossing: r replaces the active regions of its subsystem. Entering a sliding mode: r is
     // added to them. Per boundary the crossing first; the sliding candidate is accepted only
-    // with theta strictly inside the simplex (sliding_is_filippov).
-    std::vector<int> crossing, sliding = predicted;
-    for (int r : predicted)
-      if (subsystem_of(model_, r) != k) crossing.push_back(r);
-    crossing.push_back(v.r);
-    std::sort(crossing.begin(), crossing.end());
+    // with theta strictly inside the simplex (sliding_is_filippov). Then, where several regions
+    // of the subsystem fail at the same point (the state reaches two surfaces' intersection:
+    // periodic_stick_slip.toml), the two-region sets {j, r'} with r' failing and j active or
+    // failing: a regular selection of the co-dimension-2 sliding mode (see selections()).
+    std::vector<int> sliding = active_k;
     sliding.push_back(v.r);
-    std::sort(sliding.begin(), sliding.end());
+    std::vector<std::vector<int>> pairs;
+    std::vector<int> pool = active_k;
+    pool.insert(pool.end(), v.also.begin(), v.also.end());
+    for (int r2 : v.also)
+      for (int j : pool)
+        if (j != r2) {
+          std::vector<int> pair{std::min(j, r2), std::max(j, r2)};
+          if (pair != sliding && std::find(pairs.begin(), pairs.end(), pair) == pairs.end())
+            pairs.push_back(pair);
+        }
     for (int b : boundaries_for(ts)) {
-      candidates.push_back({Kind::Crossing, crossing, b});
-      candidates.push_back({Kind::SlidingEntry, sliding, b});
+      candidates.push_back({Kind::Crossing, with_k({v.r}), b});
+      candidates.push_back({Kind::SlidingEntry, with_k(sliding), b});
+      if (v.also.size() > 1)
+        for (const auto& pair : pairs) candidates.push_back({Kind::SlidingEntry, with_k(pair), b});
     }
   }
   const std::vector<double> w_pred = w_;
@@ -132,8 +171,15 @@ bool ActiveSetStep::solve(const Eigen::VectorXd& x0, const std::vector<int>& pre
     for (int n = c.b; n < iv_->N_FE(); ++n) active[n] = c.after;
     switched_guess(w_pred, predicted, c.after, c.b, ts);
     ++tries_;
-    const int pin = c.kind == Kind::Exit && c.b > 0 ? iv_->theta(c.b - 1, iv_->n_s() - 1, v.r) : -1;
-    if (!newton(active, pin).converged) continue;
+    std::vector<nlp::Bound> extra;
+    if (c.kind == Kind::Exit && c.b > 0) {
+      extra.push_back({iv_->theta(c.b - 1, iv_->n_s() - 1, v.r), 0.0, 0.0});
+      if (c.free_at_boundary >= 0) {
+        const int lam = iv_->lambda_points(c.b)[0][c.free_at_boundary];
+        extra.push_back({lam, nlp_.x_lb[lam], nlp_.x_ub[lam]});
+      }
+    }
+    if (!newton(active, extra).converged) continue;
     const Violation again = check_signs(active);
     if (again.bad || again.r >= 0) continue;
     if (c.kind == Kind::SlidingEntry && !sliding_is_filippov(active, k, c.b)) continue;
@@ -141,6 +187,37 @@ bool ActiveSetStep::solve(const Eigen::VectorXd& x0, const std::vector<int>& pre
     return true;
   }
   return false;
+}
+
+std::vector<std::vector<int>> ActiveSetStep::selections(const std::vector<int>& prediction,
+                                                        const dcs::LpSolution& lp) const {
+  // A subsystem with more active regions than one plus its number of independent switching
+  // conditions has a family of theta (periodic_stick_slip.toml on x2 = 0.2, x3 = 0.4: f_0 = f_1
+  // there, theta_0 + theta_1 is determined, the split is not): the square system is singular, or
+  // not square at all (the LP at the fixed start state repeats a condition). Selection rule: one
+  // region of such a subsystem is left out (theta = 0 for it: one member of the family), those
+  // with the least theta at the step start first; the signs then decide as for any set (lambda
+  // >= 0 of the left-out region included), so a selection that changes the state is refused.
+  std::vector<std::vector<int>> out{prediction};
+  for (int k = 0; k < model_.n_sys(); ++k) {
+    std::vector<int> in_k;
+    for (int r : prediction)
+      if (subsystem_of(model_, r) == k) in_k.push_back(r);
+    if (in_k.size() < 3) continue;
+    std::sort(in_k.begin(), in_k.end(), [&](int a, int b) { return lp.theta[a] < lp.theta[b]; });
+    // the least theta out, then the two least, ... down to two regions; then each other one out
+    std::vector<int> set = prediction;
+    for (std::size_t i = 0; i + 2 < in_k.size(); ++i) {
+      std::erase(set, in_k[i]);
+      out.push_back(set);
+    }
+    for (std::size_t i = 1; i < in_k.size(); ++i) {
+      set = prediction;
+      std::erase(set, in_k[i]);
+      if (std::find(out.begin(), out.end(), set) == out.end()) out.push_back(set);
+    }
+  }
+  return out;
 }
 
 bool ActiveSetStep::sliding_is_filippov(const Sets& active, int k, int b) const {
@@ -159,7 +236,7 @@ bool ActiveSetStep::sliding_is_filippov(const Sets& active, int k, int b) const 
   return true;
 }
 
-ActiveSetTry ActiveSetStep::newton(const Sets& active, int pin) {
+ActiveSetTry ActiveSetStep::newton(const Sets& active, const std::vector<nlp::Bound>& extra) {
   const discretization::FesdInterval& iv = *iv_;
   const int N = iv.N_FE();
   lb_ = nlp_.x_lb;
@@ -168,7 +245,10 @@ ActiveSetTry ActiveSetStep::newton(const Sets& active, int pin) {
     lb_[bd.var] = bd.lb;
     ub_[bd.var] = bd.ub;
   }
-  if (pin >= 0) lb_[pin] = ub_[pin] = 0;  // a sliding exit: theta_r = 0 at the boundary
+  for (const nlp::Bound& bd : extra) {  // a sliding exit: theta_r = 0 at the boundary
+    lb_[bd.var] = bd.lb;
+    ub_[bd.var] = bd.ub;
+  }
   free_.clear();
   col_of_.assign(lb_.size(), -1);
   for (std::size_t j = 0; j < lb_.size(); ++j) {
@@ -278,6 +358,11 @@ ActiveSetStep::Violation ActiveSetStep::check_signs(const Sets& active) const {
         const double lam = w_[points[q][r]];
         if (lam < -kSignTol) {
           violated(r, t, lam, false);
+          // the other regions of r's subsystem that fail at the same point
+          const int k = subsystem_of(model_, r);
+          for (int j = r; j < model_.region_offset(k + 1); ++j)
+            if (!discretization::has(active[n], j) && w_[points[q][j]] < -kSignTol)
+              v.also.push_back(j);
           return v;
         }
         t_ok[r] = t;
@@ -337,7 +422,22 @@ void ActiveSetStep::switched_guess(const std::vector<double>& w_pred,
       }
     return;
   }
-  if (in.size() != 1) return;
+  if (in.size() != 1 || out.size() > 1) {
+    // Several regions in or out (co-dimension 2): theta uniform on the new set of each subsystem
+    // that changes.
+    const auto uniform = [&](int r) {
+      const int k = subsystem_of(model_, r);
+      int m = 0;
+      for (int j : after) m += subsystem_of(model_, j) == k;
+      for (int n = b; n < N; ++n)
+        for (int s = 0; s < n_s; ++s)
+          for (int j = model_.region_offset(k); j < model_.region_offset(k + 1); ++j)
+            w_[iv.theta(n, s, j)] = discretization::has(after, j) ? 1.0 / std::max(m, 1) : 0.0;
+    };
+    for (int r : in) uniform(r);
+    for (int r : out) uniform(r);
+    return;
+  }
   const int r_in = in[0], k = subsystem_of(model_, r_in);
   const int r_out = out.size() == 1 ? out[0] : -1;
   for (int n = b; n < N; ++n) {

@@ -53,7 +53,7 @@ class ActiveSetStep {
   /// Solves the step from x0 with every element starting in the active set `predicted` (sorted
   /// region indices), the guess from `lp` (algebraic values) and `xdot`. True when a consistent
   /// active set was found; then solution() is the step (layout interval()).
-  bool solve(const Eigen::VectorXd& x0, const std::vector<int>& predicted,
+  bool solve(const Eigen::VectorXd& x0, const std::vector<int>& prediction,
              const dcs::LpSolution& lp, const Eigen::VectorXd& xdot);
 
   const discretization::FesdInterval& interval() const { return *iv_; }
@@ -69,7 +69,7 @@ class ActiveSetStep {
   Kind kind() const { return kind_; }
 
   /// Square systems tried per step before the homotopy takes over.
-  static constexpr int kMaxTries = 6;
+  static constexpr int kMaxTries = 12;
   /// A sliding entry is accepted only with every theta of the sliding subsystem above this at
   /// every stage after the entry (strictly inside the simplex: sliding_is_filippov()).
   static constexpr double kSlidingThetaTol = 1e-6;
@@ -80,9 +80,9 @@ class ActiveSetStep {
 
  private:
   using Sets = std::vector<std::vector<int>>;
-  /// Newton's method from w_ with the active sets `active` (and variable `pin` fixed to 0 if
-  /// >= 0: theta_r at the end of the element before a sliding exit); w_ is the result.
-  ActiveSetTry newton(const Sets& active, int pin = -1);
+  /// Newton's method from w_ with the active sets `active` and the bounds `extra` on top (a
+  /// sliding exit: theta_r = 0 at the end of the element before it); w_ is the result.
+  ActiveSetTry newton(const Sets& active, const std::vector<nlp::Bound>& extra = {});
   /// The first violated sign in time order, or r = -1 if the signs hold: lambda_r < 0 off the set
   /// (a region entering, exit = false) or theta_r < 0 on it (a region leaving a sliding mode,
   /// exit = true), at time t_bad, with value val_bad; t_ok, val_ok: the last point where that
@@ -90,6 +90,9 @@ class ActiveSetStep {
   struct Violation {
     int r = -1;
     bool exit = false;
+    /// An entry: every region of r's subsystem off the set whose lambda fails at that point (r
+    /// first).
+    std::vector<int> also;
     double t_ok = 0, t_bad = 0, val_ok = 0, val_bad = 0;
     bool bad = false;
   };
@@ -99,7 +102,16 @@ class ActiveSetStep {
     Kind kind;
     std::vector<int> after;
     int b = 0;
+    /// An exit into another region j of the subsystem: lambda_j at the boundary stays free.
+    int free_at_boundary = -1;
   };
+  /// The active sets tried for the step's prediction, in order: `prediction` (the end of the step
+  /// before), then for every subsystem with three or more active regions (co-dimension >= 2
+  /// sliding, whose theta may be a one-parameter family) the prediction without its region of
+  /// least theta in `lp` (the step start), without the two least, ... down to two regions, then
+  /// without each other one.
+  std::vector<std::vector<int>> selections(const std::vector<int>& prediction,
+                                           const dcs::LpSolution& lp) const;
   /// A sliding entry into subsystem k at boundary b is a Filippov sliding mode: theta^k strictly
   /// inside its simplex at every stage from element b on (kSlidingThetaTol).
   bool sliding_is_filippov(const Sets& active, int k, int b) const;
