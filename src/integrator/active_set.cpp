@@ -135,7 +135,7 @@ bool ActiveSetStep::solve(const Eigen::VectorXd& x0, const std::vector<int>& pre
     for (int b : boundaries_for(ts)) {
       if (b > 0 && !iv_->can_pin_exits()) continue;
       candidates.push_back({Kind::Exit, after, b});
-      if (b > 0 && active_k.size() > 2)
+      if (b > 0)
         for (int j : off_k) candidates.push_back({Kind::Exit, with_k({j}), b, j});
     }
   } else {
@@ -172,16 +172,19 @@ bool ActiveSetStep::solve(const Eigen::VectorXd& x0, const std::vector<int>& pre
     switched_guess(w_pred, predicted, c.after, c.b, ts);
     ++tries_;
     std::vector<nlp::Bound> extra;
+    int lam_free = -1;
     if (c.kind == Kind::Exit && c.b > 0) {
       extra.push_back({iv_->theta(c.b - 1, iv_->n_s() - 1, v.r), 0.0, 0.0});
       if (c.free_at_boundary >= 0) {
-        const int lam = iv_->lambda_points(c.b)[0][c.free_at_boundary];
-        extra.push_back({lam, nlp_.x_lb[lam], nlp_.x_ub[lam]});
+        lam_free = iv_->lambda_points(c.b)[0][c.free_at_boundary];
+        extra.push_back({lam_free, nlp_.x_lb[lam_free], nlp_.x_ub[lam_free]});
       }
     }
     if (!newton(active, extra).converged) continue;
     const Violation again = check_signs(active);
     if (again.bad || again.r >= 0) continue;
+    // an exit into region j: the state is on j's boundary there (lambda_j = 0 to the tolerance)
+    if (lam_free >= 0 && std::abs(w_[lam_free]) > kSignTol) continue;
     if (c.kind == Kind::SlidingEntry && !sliding_is_filippov(active, k, c.b)) continue;
     kind_ = c.kind;
     return true;
