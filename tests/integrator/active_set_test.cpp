@@ -250,6 +250,37 @@ TEST(ActiveSetSliding, TemperatureControlSameAsHomotopy) {
   EXPECT_LE(b.active.summary.homotopy_path_steps, 5);
 }
 
+// examples/periodic_stick_slip.toml (nosnoc_py's codim-2 example: one subsystem, four regions of
+// c = (x2 - 0.2, x3 - 0.4), Radau IIA n_s = 4, N_FE = 3, N_sim = 100 on [0, 20]). On the
+// intersection of both surfaces f_0 = f_1, so the four-region set has a one-parameter family of
+// theta: its system is not square. Every step runs on the active-set path with the regular
+// selection {0, 3} (theta_1 = theta_2 = 0: ActiveSetStep::selections, the two-region sets of an
+// entry), and the switches are the 7 events of the event-driven solution (the file's comment;
+// here to 10 digits from an RK4 integration with step 1e-3 and 5e-4, events by bisection, which
+// agree to 1e-12), x(20) = (1.22894361753, -0.260185061673, -0.0601850616733) from it. The
+// homotopy path (66 s CPU, not run here) lists 17 switches on this grid: 10 more than the events
+// (changes between {1, 3}, {0, 1, 3} and {0, 1, 2, 3} on the intersection, short visits of region
+// 1 at entries and exits), and its x(20) is 3.2e-4 off.
+TEST(ActiveSetSliding, StickSlipCodimensionTwoEvents) {
+  fesd::SimulationProblem q =
+      fesd::load_simulation_problem(FESD_SOURCE_DIR "/examples/periodic_stick_slip.toml");
+  fesd::apply_override(q, "step_solver", "active_set");
+  const IntegratorResult r = fesd::integrate(q.model, q.x0, q.T_sim, q.N_sim, q.options, q.u, q.p);
+  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+  EXPECT_EQ(r.summary.active_set_path_steps, 100);
+  EXPECT_EQ(r.summary.homotopy_path_steps, 0);
+  const double events[] = {0.2443307896,  0.5549932425,  2.7880473074, 7.5239056551,
+                           10.6157314133, 15.3515897609, 18.4434155192};
+  ASSERT_EQ(r.switches.size(), 7u);
+  for (std::size_t i = 0; i < 7; ++i) {
+    EXPECT_NEAR(r.switches[i].t, events[i], 1e-8) << "switch " << i;
+    EXPECT_TRUE(r.switches[i].located);
+  }
+  EXPECT_EQ(r.switches[1].after, (std::vector<int>{0, 3}));  // both surfaces: the selection
+  const Eigen::Vector3d x_ref(1.22894361753, -0.260185061673, -0.0601850616733);
+  EXPECT_LT((r.x_final() - x_ref).lpNorm<Eigen::Infinity>(), 1e-8);
+}
+
 TEST(ActiveSetOptions, UnknownValueIsAClearError) {
   fesd::SimulationProblem q =
       fesd::load_simulation_problem(FESD_SOURCE_DIR "/examples/oscillator.toml");
