@@ -12,10 +12,13 @@
 //
 // ActiveSetStep solves it by Newton's method with the exact Jacobian (forward AD of the blocks,
 // a dense LU of Eigen), for the active set predicted from the previous step's end, then checks the
-// signs (theta >= 0 on, lambda >= 0 off the active set, h_n within its bounds). A violated lambda
-// >= 0 is a switch inside the step: the region is swapped in (a crossing) from an element boundary
-// chosen from the estimated switch time, and the system with that boundary's length free is
-// solved. If no consistent active set is found within
+// signs (theta >= 0 on, lambda >= 0 off the active set, h_n within its bounds). A violated lambda_r
+// >= 0 is a region entering inside the step: a crossing (r replaces its subsystem's regions), then
+// a sliding entry (r added; accepted only with theta strictly inside the simplex, the Filippov
+// condition), from an element boundary chosen from the estimated switch time, that boundary's
+// length free. A violated theta_r >= 0 in a sliding set is an exit: r leaves, theta_r = 0 at the
+// boundary is the switch condition. Co-dimension-2 sliding in one subsystem (a family of theta)
+// is reduced to a regular selection (selections()). If no consistent active set is found within
 // kMaxTries square systems, solve() returns false and the integrator uses the homotopy.
 #pragma once
 #include <vector>
