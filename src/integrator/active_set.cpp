@@ -89,6 +89,7 @@ bool ActiveSetStep::solve(const Eigen::VectorXd& x0, const std::vector<int>& pre
   for (int r = 0; r < model_.n_theta(); ++r) w_[in_.lambda_start[r]] = lp.lambda[r];
   for (int k = 0; k < model_.n_sys(); ++k) w_[in_.mu_start[k]] = lp.mu[k];
   iv_->set_guess(w_, x0, lp, xdot);
+  theta_start_ = lp.theta;
 
   // The prediction, then (if its system is not square or singular) the selections of a
   // co-dimension-2 sliding mode (selections()).
@@ -328,7 +329,9 @@ ActiveSetStep::Violation ActiveSetStep::check_signs(const Sets& active) const {
   // In time order: theta >= 0 on the active set (a failure in a sliding set is an exit of that
   // region; in a set with one region of its subsystem theta is 1), lambda >= 0 off it (an entry);
   // per region the last point where its sign held.
+  // Before the first stage: theta at the step start (the end of the step before).
   std::vector<double> t_ok(n_th, 0.0), val_ok(n_th, 0.0);
+  for (int r : active[0]) val_ok[r] = std::max(theta_start_[r], 0.0);
   const auto violated = [&](int r, double t, double val, bool exit) {
     v.r = r;
     v.exit = exit;
@@ -348,7 +351,6 @@ ActiveSetStep::Violation ActiveSetStep::check_signs(const Sets& active) const {
         for (int r : active[n]) {
           const double th = w_[iv.theta(n, qi - 1, r)];
           if (th < -kSignTol) {
-            // the first stage of the step: no earlier point where it held (t_ok = 0, th_ok = 0)
             violated(r, t, th, true);
             return v;
           }
@@ -379,9 +381,9 @@ ActiveSetStep::Violation ActiveSetStep::check_signs(const Sets& active) const {
 
 std::vector<int> ActiveSetStep::boundaries_for(double ts) const {
   const int N = iv_->N_FE();
-  // The sign failed at the step's first point: the switch is at its start (an exit of a region
-  // whose theta reached 0 at the end of the step before), not after an element of length 0.
-  if (ts <= 0) return {0};
+  // The switch at the step's start (within 1e-9 T: an exit of a region whose theta reached 0 at
+  // the end of the step before), not after an element of length ~0.
+  if (ts <= 1e-9 * T_) return {0};
   const double h0 = T_ / N, lo = nlp_.x_lb[iv_->h(0)], hi = nlp_.x_ub[iv_->h(0)];
   const auto within = [&](double h) { return h >= lo && h <= hi; };
   std::vector<std::pair<double, int>> cost;

@@ -140,6 +140,7 @@ class ActiveSetStep {
   Eigen::MatrixXd J_;
   Eigen::VectorXd F_, dz_;
   std::vector<double> g_, jac_;
+  Eigen::VectorXd theta_start_;  // theta at the step start (the guess's LP): exit times
   int iterations_ = 0, tries_ = 0;
   Kind kind_ = Kind::Prediction;
 };
