@@ -148,6 +148,7 @@ bool ActiveSetStep::solve(const Eigen::VectorXd& x0, const std::vector<int>& pre
     // failing: a regular selection of the co-dimension-2 sliding mode (see selections()).
     std::vector<int> sliding = active_k;
     sliding.push_back(v.r);
+    std::sort(sliding.begin(), sliding.end());
     std::vector<std::vector<int>> pairs;
     std::vector<int> pool = active_k;
     pool.insert(pool.end(), v.also.begin(), v.also.end());
@@ -198,10 +199,11 @@ std::vector<std::vector<int>> ActiveSetStep::selections(const std::vector<int>& 
   // A subsystem with more active regions than one plus its number of independent switching
   // conditions has a family of theta (periodic_stick_slip.toml on x2 = 0.2, x3 = 0.4: f_0 = f_1
   // there, theta_0 + theta_1 is determined, the split is not): the square system is singular, or
-  // not square at all (the LP at the fixed start state repeats a condition). Selection rule: one
-  // region of such a subsystem is left out (theta = 0 for it: one member of the family), those
-  // with the least theta at the step start first; the signs then decide as for any set (lambda
-  // >= 0 of the left-out region included), so a selection that changes the state is refused.
+  // not square at all (the LP at the fixed start state repeats a condition). Selection rule:
+  // regions of such a subsystem are left out (theta = 0 for them: one member of the family), the
+  // one of least theta at the step start, then the two least, ... down to two regions, then each
+  // other one alone; the signs then decide as for any set (lambda >= 0 of the left-out regions
+  // included), so a selection that changes the state is refused.
   std::vector<std::vector<int>> out{prediction};
   for (int k = 0; k < model_.n_sys(); ++k) {
     std::vector<int> in_k;
