@@ -1,8 +1,11 @@
 // bench/active_set_step.cpp: the two step solvers side by side (issue 15 item 3, first number;
 // docs/active-set.md, docs/benchmarks.md "Active-set step solver").
 //
-// The oscillator (47) of papers/fesd-filippov.txt, Radau IIA n_s = 3, N_FE = 2, T = pi/2, and
-// Example 3(a) (x' in 2 - sign(x), x0 = -1, T = 1.9), integrated with step_solver = homotopy and
+// The oscillator (47) of papers/fesd-filippov.txt, Radau IIA n_s = 3, N_FE = 2, T = pi/2,
+// Example 3(a) (x' in 2 - sign(x), x0 = -1, T = 1.9), and the sliding modes of the second slice:
+// Example 3(b) (x' in -sign(x), x0 = 0.47, T = 1: enters sliding at t = 0.47, x(T) = 0) and
+// Example 3(c) (x' in -sign(x) + t, x0 = 0, T = 1.9: leaves at t = 1, x(T) = 0.9^2 / 2; the time as
+// a second state), integrated with step_solver = homotopy and
 // step_solver = active_set in one process: per path the median over R repetitions of the time of
 // integrate() (in-process wall time and this process's CPU time), per step, the Newton iterations
 // and the IPOPT iterations per step, the steps each path solved, the error of x(T) against the
@@ -39,6 +42,31 @@ namespace fesd_bench {
 }  // namespace fesd_bench
 
 namespace {
+
+/// Example 3(b): x' in -sign(x) (region 0: x > 0, x' = -1; region 1: x < 0, x' = 1).
+struct SlidingModel {
+  template <class T>
+  void c(const T* x, const T*, T* c) const {
+    c[0] = x[0];
+  }
+  template <class T>
+  void f(int region, const T*, const T*, const T*, T* f) const {
+    f[0] = T(region == 0 ? -1.0 : 1.0);
+  }
+};
+
+/// Example 3(c): x' in -sign(x) + t, with the time t = x[1] as a state (t' = 1).
+struct LeavingModel {
+  template <class T>
+  void c(const T* x, const T*, T* c) const {
+    c[0] = x[0];
+  }
+  template <class T>
+  void f(int region, const T* x, const T*, const T*, T* f) const {
+    f[0] = (region == 0 ? -1.0 : 1.0) + x[1];
+    f[1] = T(1.0);
+  }
+};
 
 struct Case {
   std::string name;
@@ -139,6 +167,15 @@ int main(int argc, char** argv) {
                       fesd::PssDims{.n_x = 1, .subsystems = {fesd::Subsystem::from_c(1)}}),
        Eigen::VectorXd::Constant(1, -1.0), Eigen::VectorXd::Constant(1, 1.9 - 1.0 / 3.0), 1.9,
        1.0 / 3.0, 3});
+
+  const fesd::PssDims one_c{.n_x = 1, .subsystems = {fesd::Subsystem::from_c(1)}};
+  cases.push_back({"Example 3(b)", fesd::make_pss(SlidingModel{}, one_c),
+                   Eigen::VectorXd::Constant(1, 0.47), Eigen::VectorXd::Zero(1), 1.0, 0.47, 3});
+  cases.push_back(
+      {"Example 3(c)",
+       fesd::make_pss(LeavingModel{},
+                      fesd::PssDims{.n_x = 2, .subsystems = {fesd::Subsystem::from_c(1)}}),
+       Eigen::VectorXd::Zero(2), Eigen::Vector2d(0.5 * 0.9 * 0.9, 1.9), 1.9, 1.0, 3});
 
   std::vector<Row> rows;
   for (const Case& c : cases) {

@@ -80,54 +80,178 @@ ActiveSetStep::ActiveSetStep(const Pss& model, const Tableau& tab, const Discret
   jac_.resize(nlp_.jac_nnz());
 }
 
-bool ActiveSetStep::solve(const Eigen::VectorXd& x0, const std::vector<int>& predicted,
+bool ActiveSetStep::solve(const Eigen::VectorXd& x0, const std::vector<int>& prediction,
                           const dcs::LpSolution& lp, const Eigen::VectorXd& xdot) {
   iterations_ = tries_ = 0;
+  kind_ = Kind::Prediction;
   fix(nlp_, in_.s0, x0);
   w_ = nlp_.x_init;
   for (int r = 0; r < model_.n_theta(); ++r) w_[in_.lambda_start[r]] = lp.lambda[r];
   for (int k = 0; k < model_.n_sys(); ++k) w_[in_.mu_start[k]] = lp.mu[k];
   iv_->set_guess(w_, x0, lp, xdot);
+  theta_start_ = lp.theta;
 
+  // The prediction, then (if its system is not square or singular) the selections of a
+  // co-dimension-2 sliding mode (selections()).
+  std::vector<int> predicted;
+  const std::vector<double> w_guess = w_;
+  for (const std::vector<int>& set : selections(prediction, lp)) {
+    if (tries_ >= kMaxTries) return false;
+    w_ = w_guess;
+    ++tries_;
+    if (newton(Sets(iv_->N_FE(), set)).converged) {
+      predicted = set;
+      break;
+    }
+  }
+  if (predicted.empty()) return false;
   const Sets predicted_sets(iv_->N_FE(), predicted);
-  ++tries_;
-  if (!newton(predicted_sets).converged) return false;
   const Violation v = check_signs(predicted_sets);
   if (v.bad) return false;
   if (v.r < 0) return true;
 
-  // A switch inside the step: region v.r enters. Its time from lambda_r, linear between the last
-  // point where lambda_r >= 0 held and the first where it failed.
-  const double ts = v.t_ok + (v.t_bad - v.t_ok) * v.lam_ok / std::max(v.lam_ok - v.lam_bad, 1e-300);
-  // A crossing: r replaces the active regions of its subsystem. (Entering a sliding mode, r added
-  // to them, is left to the homotopy for now: tried as a second candidate it accepted a spurious
-  // sliding solution of examples/temperature_control.toml, where the homotopy crosses.)
+  // A switch inside the step: region v.r enters (v.exit: leaves). Its time from lambda_r (theta_r),
+  // linear between the last point where the sign held and the first where it failed.
+  const double ts = v.t_ok + (v.t_bad - v.t_ok) * v.val_ok / std::max(v.val_ok - v.val_bad, 1e-300);
   const int k = subsystem_of(model_, v.r);
-  std::vector<int> crossing;
-  for (int r : predicted)
-    if (subsystem_of(model_, r) != k) crossing.push_back(r);
-  crossing.push_back(v.r);
-  std::sort(crossing.begin(), crossing.end());
+  // The predicted set with subsystem k's regions replaced by `regions_k` (sorted).
+  const auto with_k = [&](std::vector<int> regions_k) {
+    for (int r : predicted)
+      if (subsystem_of(model_, r) != k) regions_k.push_back(r);
+    std::sort(regions_k.begin(), regions_k.end());
+    return regions_k;
+  };
+  std::vector<int> active_k, off_k;
+  for (int r = model_.region_offset(k); r < model_.region_offset(k + 1); ++r)
+    (discretization::has(predicted, r) ? active_k : off_k).push_back(r);
+  std::vector<Candidate> candidates;
+  if (v.exit) {
+    // Leaving a sliding mode: r leaves the set; at the boundary b theta_r = 0 (the pin of
+    // FesdInterval::pin_bounds) replaces h_b = h_{b-1}. b = 0: the whole step without r. Then
+    // (co-dimension 2: the state leaves both surfaces at once) a region j off the set replacing
+    // the subsystem's regions after the pin, lambda_j at the boundary free (not a second switch
+    // condition: on the intersection lambda_j = 0 holds whatever the boundary's time).
+    std::vector<int> after = predicted;
+    std::erase(after, v.r);
+    for (int b : boundaries_for(ts)) {
+      if (b > 0 && !iv_->can_pin_exits()) continue;
+      candidates.push_back({Kind::Exit, after, b});
+      if (b > 0)
+        for (int j : off_k) candidates.push_back({Kind::Exit, with_k({j}), b, j});
+    }
+  } else {
+    // A crossing: r replaces the active regions of its subsystem. Entering a sliding mode: r is
+    // added to them. Per boundary the crossing first; the sliding candidate is accepted only
+    // with theta strictly inside the simplex (sliding_is_filippov). Then, where several regions
+    // of the subsystem fail at the same point (the state reaches two surfaces' intersection:
+    // periodic_stick_slip.toml), the two-region sets {j, r'} with r' failing and j active or
+    // failing: a regular selection of the co-dimension-2 sliding mode (see selections()).
+    std::vector<int> sliding = active_k;
+    sliding.push_back(v.r);
+    std::sort(sliding.begin(), sliding.end());
+    std::vector<std::vector<int>> pairs;
+    std::vector<int> pool = active_k;
+    pool.insert(pool.end(), v.also.begin(), v.also.end());
+    for (int r2 : v.also)
+      for (int j : pool)
+        if (j != r2) {
+          std::vector<int> pair{std::min(j, r2), std::max(j, r2)};
+          if (pair != sliding && std::find(pairs.begin(), pairs.end(), pair) == pairs.end())
+            pairs.push_back(pair);
+        }
+    for (int b : boundaries_for(ts)) {
+      candidates.push_back({Kind::Crossing, with_k({v.r}), b});
+      candidates.push_back({Kind::SlidingEntry, with_k(sliding), b});
+      if (v.also.size() > 1)
+        for (const auto& pair : pairs) candidates.push_back({Kind::SlidingEntry, with_k(pair), b});
+    }
+  }
   const std::vector<double> w_pred = w_;
-  for (int b : boundaries_for(ts)) {
+  for (const Candidate& c : candidates) {
     if (tries_ >= kMaxTries) return false;
     Sets active = predicted_sets;
-    for (int n = b; n < iv_->N_FE(); ++n) active[n] = crossing;
-    switched_guess(w_pred, predicted, crossing, b, ts);
+    for (int n = c.b; n < iv_->N_FE(); ++n) active[n] = c.after;
+    switched_guess(w_pred, predicted, c.after, c.b, ts);
     ++tries_;
-    if (!newton(active).converged) continue;
+    std::vector<nlp::Bound> extra;
+    int lam_free = -1;
+    if (c.kind == Kind::Exit && c.b > 0) {
+      extra.push_back({iv_->theta(c.b - 1, iv_->n_s() - 1, v.r), 0.0, 0.0});
+      if (c.free_at_boundary >= 0) {
+        lam_free = iv_->lambda_points(c.b)[0][c.free_at_boundary];
+        extra.push_back({lam_free, nlp_.x_lb[lam_free], nlp_.x_ub[lam_free]});
+      }
+    }
+    if (!newton(active, extra).converged) continue;
     const Violation again = check_signs(active);
-    if (!again.bad && again.r < 0) return true;
+    if (again.bad || again.r >= 0) continue;
+    // an exit into region j: the state is on j's boundary there (lambda_j = 0 to the tolerance)
+    if (lam_free >= 0 && std::abs(w_[lam_free]) > kSignTol) continue;
+    if (c.kind == Kind::SlidingEntry && !sliding_is_filippov(active, k, c.b)) continue;
+    kind_ = c.kind;
+    return true;
   }
   return false;
 }
 
-ActiveSetTry ActiveSetStep::newton(const Sets& active) {
+std::vector<std::vector<int>> ActiveSetStep::selections(const std::vector<int>& prediction,
+                                                        const dcs::LpSolution& lp) const {
+  // A subsystem with more active regions than one plus its number of independent switching
+  // conditions has a family of theta (periodic_stick_slip.toml on x2 = 0.2, x3 = 0.4: f_0 = f_1
+  // there, theta_0 + theta_1 is determined, the split is not): the square system is singular, or
+  // not square at all (the LP at the fixed start state repeats a condition). Selection rule:
+  // regions of such a subsystem are left out (theta = 0 for them: one member of the family), the
+  // one of least theta at the step start, then the two least, ... down to two regions, then each
+  // other one alone; the signs then decide as for any set (lambda >= 0 of the left-out regions
+  // included), so a selection that changes the state is refused.
+  std::vector<std::vector<int>> out{prediction};
+  for (int k = 0; k < model_.n_sys(); ++k) {
+    std::vector<int> in_k;
+    for (int r : prediction)
+      if (subsystem_of(model_, r) == k) in_k.push_back(r);
+    if (in_k.size() < 3) continue;
+    std::sort(in_k.begin(), in_k.end(), [&](int a, int b) { return lp.theta[a] < lp.theta[b]; });
+    // the least theta out, then the two least, ... down to two regions; then each other one out
+    std::vector<int> set = prediction;
+    for (std::size_t i = 0; i + 2 < in_k.size(); ++i) {
+      std::erase(set, in_k[i]);
+      out.push_back(set);
+    }
+    for (std::size_t i = 1; i < in_k.size(); ++i) {
+      set = prediction;
+      std::erase(set, in_k[i]);
+      if (std::find(out.begin(), out.end(), set) == out.end()) out.push_back(set);
+    }
+  }
+  return out;
+}
+
+bool ActiveSetStep::sliding_is_filippov(const Sets& active, int k, int b) const {
+  // With the entering region r in the set, the sliding theta^k lies strictly inside the simplex
+  // at every stage after the entry: both fields point toward the surface (for two regions theta_r
+  // = grad c . f_a / grad c . (f_a - f_r) in (0, 1) iff the normal components have opposite
+  // signs, and f_a points toward the surface, since the state reached it). A theta at 0 (a field
+  // tangent to the surface, e.g. a Filippov equilibrium on it) is not accepted: the crossing
+  // failed, and the homotopy decides.
+  const discretization::FesdInterval& iv = *iv_;
+  for (int n = b; n < iv.N_FE(); ++n)
+    for (int s = 0; s < iv.n_s(); ++s)
+      for (int r : active[n])
+        if (subsystem_of(model_, r) == k && !(w_[iv.theta(n, s, r)] > kSlidingThetaTol))
+          return false;
+  return true;
+}
+
+ActiveSetTry ActiveSetStep::newton(const Sets& active, const std::vector<nlp::Bound>& extra) {
   const discretization::FesdInterval& iv = *iv_;
   const int N = iv.N_FE();
   lb_ = nlp_.x_lb;
   ub_ = nlp_.x_ub;
   for (const nlp::Bound& bd : iv.active_set_bounds(active)) {
+    lb_[bd.var] = bd.lb;
+    ub_[bd.var] = bd.ub;
+  }
+  for (const nlp::Bound& bd : extra) {  // a sliding exit: theta_r = 0 at the boundary
     lb_[bd.var] = bd.lb;
     ub_[bd.var] = bd.ub;
   }
@@ -142,7 +266,8 @@ ActiveSetTry ActiveSetStep::newton(const Sets& active) {
     }
   }
   // h_n = h_{n-1} where the active set does not change; at a switch the boundary's length is
-  // free and the switch condition (lambda = 0 of both regions there, fixed above) takes its row.
+  // free and the switch condition takes its row: lambda = 0 of both regions there (a crossing,
+  // a sliding entry; fixed above), or theta_r = 0 of the leaving region (an exit: the pin).
   std::vector<int> equal;
   for (int n = 1; n < N; ++n)
     if (active[n] == active[n - 1]) equal.push_back(n);
@@ -202,36 +327,53 @@ ActiveSetStep::Violation ActiveSetStep::check_signs(const Sets& active) const {
       v.bad = true;
       return v;
     }
-    for (int s = 0; s < n_s; ++s)
-      for (int r : active[n])
-        if (w_[iv.theta(n, s, r)] < -kSignTol) {
-          v.bad = true;  // a sliding exit: not handled by this path
-          return v;
-        }
   }
-  // lambda >= 0 off the active set, in time order; per region the last point where it held.
-  std::vector<double> t_ok(n_th, 0.0), lam_ok(n_th, 0.0);
+  // In time order: theta >= 0 on the active set (a failure in a sliding set is an exit of that
+  // region; in a set with one region of its subsystem theta is 1), lambda >= 0 off it (an entry);
+  // per region the last point where its sign held.
+  // Before the first stage: theta at the step start (the end of the step before).
+  std::vector<double> t_ok(n_th, 0.0), val_ok(n_th, 0.0);
+  for (int r : active[0]) val_ok[r] = std::max(theta_start_[r], 0.0);
+  const auto violated = [&](int r, double t, double val, bool exit) {
+    v.r = r;
+    v.exit = exit;
+    v.t_ok = t_ok[r];
+    v.val_ok = val_ok[r];
+    v.t_bad = t;
+    v.val_bad = val;
+  };
   double t_n = 0;
   for (int n = 0; n < N; ++n) {
     const double hn = w_[iv.h(n)];
     const auto& points = iv.lambda_points(n);
     for (std::size_t q = 0; q < points.size(); ++q) {
-      if (!iv.point_signed(n, static_cast<int>(q))) continue;
       const int qi = static_cast<int>(q);
       const double t = q == 0 ? t_n : qi <= n_s ? t_n + tab_.c(qi - 1) * hn : t_n + hn;
+      if (qi >= 1 && qi <= n_s)
+        for (int r : active[n]) {
+          const double th = w_[iv.theta(n, qi - 1, r)];
+          if (th < -kSignTol) {
+            violated(r, t, th, true);
+            return v;
+          }
+          t_ok[r] = t;
+          val_ok[r] = th;
+        }
+      if (!iv.point_signed(n, qi)) continue;
       for (int r = 0; r < n_th; ++r) {
         if (discretization::has(active[n], r)) continue;
         const double lam = w_[points[q][r]];
         if (lam < -kSignTol) {
-          v.r = r;
-          v.t_ok = t_ok[r];
-          v.lam_ok = lam_ok[r];
-          v.t_bad = t;
-          v.lam_bad = lam;
+          violated(r, t, lam, false);
+          // the other regions of r's subsystem that fail at the same point
+          const int k = subsystem_of(model_, r);
+          for (int j = r; j < model_.region_offset(k + 1); ++j)
+            if (!discretization::has(active[n], j) && w_[points[q][j]] < -kSignTol)
+              v.also.push_back(j);
           return v;
         }
         t_ok[r] = t;
-        lam_ok[r] = lam;
+        val_ok[r] = lam;
       }
     }
     t_n += hn;
@@ -241,6 +383,9 @@ ActiveSetStep::Violation ActiveSetStep::check_signs(const Sets& active) const {
 
 std::vector<int> ActiveSetStep::boundaries_for(double ts) const {
   const int N = iv_->N_FE();
+  // The switch at the step's start (within 1e-9 T: an exit of a region whose theta reached 0 at
+  // the end of the step before), not after an element of length ~0.
+  if (ts <= 1e-9 * T_) return {0};
   const double h0 = T_ / N, lo = nlp_.x_lb[iv_->h(0)], hi = nlp_.x_ub[iv_->h(0)];
   const auto within = [&](double h) { return h >= lo && h <= hi; };
   std::vector<std::pair<double, int>> cost;
@@ -269,7 +414,37 @@ void ActiveSetStep::switched_guess(const std::vector<double>& w_pred,
     if (!discretization::has(before, r)) in.push_back(r);
   for (int r : before)
     if (!discretization::has(after, r)) out.push_back(r);
-  if (in.size() != 1) return;
+  if (in.empty() && out.size() == 1) {
+    // A sliding exit: theta of the leaving region is shared among the others of its subsystem.
+    const int r_out = out[0], k = subsystem_of(model_, r_out);
+    for (int n = b; n < N; ++n)
+      for (int s = 0; s < n_s; ++s) {
+        double rest = 0;
+        for (int r : after)
+          if (subsystem_of(model_, r) == k) rest += w_[iv.theta(n, s, r)];
+        const double scale = rest > 0 ? 1 / rest : 0;
+        for (int r : after)
+          if (subsystem_of(model_, r) == k) w_[iv.theta(n, s, r)] *= scale;
+        w_[iv.theta(n, s, r_out)] = 0;
+      }
+    return;
+  }
+  if (in.size() != 1 || out.size() > 1) {
+    // Several regions in or out (co-dimension 2): theta uniform on the new set of each subsystem
+    // that changes.
+    const auto uniform = [&](int r) {
+      const int k = subsystem_of(model_, r);
+      int m = 0;
+      for (int j : after) m += subsystem_of(model_, j) == k;
+      for (int n = b; n < N; ++n)
+        for (int s = 0; s < n_s; ++s)
+          for (int j = model_.region_offset(k); j < model_.region_offset(k + 1); ++j)
+            w_[iv.theta(n, s, j)] = discretization::has(after, j) ? 1.0 / std::max(m, 1) : 0.0;
+    };
+    for (int r : in) uniform(r);
+    for (int r : out) uniform(r);
+    return;
+  }
   const int r_in = in[0], k = subsystem_of(model_, r_in);
   const int r_out = out.size() == 1 ? out[0] : -1;
   for (int n = b; n < N; ++n) {

@@ -12,10 +12,13 @@
 //
 // ActiveSetStep solves it by Newton's method with the exact Jacobian (forward AD of the blocks,
 // a dense LU of Eigen), for the active set predicted from the previous step's end, then checks the
-// signs (theta >= 0 on, lambda >= 0 off the active set, h_n within its bounds). A violated lambda
-// >= 0 is a switch inside the step: the region is swapped in (a crossing) from an element boundary
-// chosen from the estimated switch time, and the system with that boundary's length free is
-// solved. If no consistent active set is found within
+// signs (theta >= 0 on, lambda >= 0 off the active set, h_n within its bounds). A violated lambda_r
+// >= 0 is a region entering inside the step: a crossing (r replaces its subsystem's regions), then
+// a sliding entry (r added; accepted only with theta strictly inside the simplex, the Filippov
+// condition), from an element boundary chosen from the estimated switch time, that boundary's
+// length free. A violated theta_r >= 0 in a sliding set is an exit: r leaves, theta_r = 0 at the
+// boundary is the switch condition. Co-dimension-2 sliding in one subsystem (a family of theta)
+// is reduced to a regular selection (selections()). If no consistent active set is found within
 // kMaxTries square systems, solve() returns false and the integrator uses the homotopy.
 #pragma once
 #include <vector>
@@ -53,7 +56,7 @@ class ActiveSetStep {
   /// Solves the step from x0 with every element starting in the active set `predicted` (sorted
   /// region indices), the guess from `lp` (algebraic values) and `xdot`. True when a consistent
   /// active set was found; then solution() is the step (layout interval()).
-  bool solve(const Eigen::VectorXd& x0, const std::vector<int>& predicted,
+  bool solve(const Eigen::VectorXd& x0, const std::vector<int>& prediction,
              const dcs::LpSolution& lp, const Eigen::VectorXd& xdot);
 
   const discretization::FesdInterval& interval() const { return *iv_; }
@@ -64,8 +67,15 @@ class ActiveSetStep {
   /// Size of the square system (per active-set shape; the last one solved).
   int system_size() const { return static_cast<int>(free_.size()); }
 
+  /// What the accepted solution of the last solve() is.
+  enum class Kind { Prediction, Crossing, SlidingEntry, Exit };
+  Kind kind() const { return kind_; }
+
   /// Square systems tried per step before the homotopy takes over.
-  static constexpr int kMaxTries = 4;
+  static constexpr int kMaxTries = 12;
+  /// A sliding entry is accepted only with every theta of the sliding subsystem above this at
+  /// every stage after the entry (strictly inside the simplex: sliding_is_filippov()).
+  static constexpr double kSlidingThetaTol = 1e-6;
   static constexpr int kMaxNewton = 25;
   /// Sign tolerance of theta >= 0, lambda >= 0 (a switch within ~kSignTol / |c'| of a step end
   /// is taken at the step end).
@@ -73,17 +83,41 @@ class ActiveSetStep {
 
  private:
   using Sets = std::vector<std::vector<int>>;
-  /// Newton's method from w_ with the active sets `active`; w_ is the result.
-  ActiveSetTry newton(const Sets& active);
-  /// The first violated lambda >= 0 (region r at time t_bad, the last time t_ok where it held),
-  /// or r = -1 if the signs hold; `bad` is set when a sign fails that no switch can repair
-  /// (theta < 0, h_n out of bounds).
+  /// Newton's method from w_ with the active sets `active` and the bounds `extra` on top (a
+  /// sliding exit: theta_r = 0 at the end of the element before it); w_ is the result.
+  ActiveSetTry newton(const Sets& active, const std::vector<nlp::Bound>& extra = {});
+  /// The first violated sign in time order, or r = -1 if the signs hold: lambda_r < 0 off the set
+  /// (a region entering, exit = false) or theta_r < 0 on it (a region leaving a sliding mode,
+  /// exit = true), at time t_bad, with value val_bad; t_ok, val_ok: the last point where that
+  /// region's sign held. `bad`: h_n out of bounds (no switch repairs it).
   struct Violation {
     int r = -1;
-    double t_ok = 0, t_bad = 0, lam_ok = 0, lam_bad = 0;
+    bool exit = false;
+    /// An entry: every region of r's subsystem off the set whose lambda fails at that point (r
+    /// first).
+    std::vector<int> also;
+    double t_ok = 0, t_bad = 0, val_ok = 0, val_bad = 0;
     bool bad = false;
   };
   Violation check_signs(const Sets& active) const;
+  /// The candidates tried after a failed prediction: elements from b on have the set `after`.
+  struct Candidate {
+    Kind kind;
+    std::vector<int> after;
+    int b = 0;
+    /// An exit into another region j of the subsystem: lambda_j at the boundary stays free.
+    int free_at_boundary = -1;
+  };
+  /// The active sets tried for the step's prediction, in order: `prediction` (the end of the step
+  /// before), then for every subsystem with three or more active regions (co-dimension >= 2
+  /// sliding, whose theta may be a one-parameter family) the prediction without its region of
+  /// least theta in `lp` (the step start), without the two least, ... down to two regions, then
+  /// without each other one.
+  std::vector<std::vector<int>> selections(const std::vector<int>& prediction,
+                                           const dcs::LpSolution& lp) const;
+  /// A sliding entry into subsystem k at boundary b is a Filippov sliding mode: theta^k strictly
+  /// inside its simplex at every stage from element b on (kSlidingThetaTol).
+  bool sliding_is_filippov(const Sets& active, int k, int b) const;
   /// Boundaries b (0..N_FE-1) where a switch at time ts can sit with every h_n within its bounds,
   /// best first (the least sum (h_n - T/N_FE)^2, the homotopy's heuristic_mean choice).
   std::vector<int> boundaries_for(double ts) const;
@@ -106,7 +140,9 @@ class ActiveSetStep {
   Eigen::MatrixXd J_;
   Eigen::VectorXd F_, dz_;
   std::vector<double> g_, jac_;
+  Eigen::VectorXd theta_start_;  // theta at the step start (the guess's LP): exit times
   int iterations_ = 0, tries_ = 0;
+  Kind kind_ = Kind::Prediction;
 };
 
 }  // namespace fesd::integrator

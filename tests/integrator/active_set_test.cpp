@@ -3,6 +3,8 @@
 // few) solved without IPOPT. Exact values from REFERENCE.md.
 #include <cmath>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -123,21 +125,160 @@ TEST(ActiveSetOscillator, ProblemFileKeyAndOverride) {
   EXPECT_NEAR(r.switches[0].t, 1.0, 1e-6);
 }
 
-// Example 3(b) (examples/sliding.toml, x' in -sign(x), x0 = 0.5): the step that enters the sliding
-// mode at t = 0.5 is not a crossing; the active-set path finds no consistent active set there and
-// that one step falls back to the homotopy. Same x(T) (0) and switch time as the homotopy path.
-TEST(ActiveSetSliding, EntryFallsBackToTheHomotopyOnce) {
-  fesd::SimulationProblem q =
-      fesd::load_simulation_problem(FESD_SOURCE_DIR "/examples/sliding.toml");
+/// Both paths on a problem file, with `overrides` (key, value) applied to both.
+Both run_file(const std::string& file,
+              const std::vector<std::pair<std::string, std::string>>& overrides = {}) {
+  fesd::SimulationProblem q = fesd::load_simulation_problem(FESD_SOURCE_DIR "/examples/" + file);
+  for (const auto& [key, value] : overrides) fesd::apply_override(q, key, value);
   Both b;
   b.homotopy = fesd::integrate(q.model, q.x0, q.T_sim, q.N_sim, q.options, q.u, q.p);
   fesd::apply_override(q, "step_solver", "active_set");
   b.active = fesd::integrate(q.model, q.x0, q.T_sim, q.N_sim, q.options, q.u, q.p);
+  return b;
+}
+
+// Example 3(b) (examples/sliding.toml, x' in -sign(x), N_sim = 10 on [0, 1]): x reaches 0 at
+// t = x0 and slides, x(T) = 0 (REFERENCE.md). x0 = 0.47 and 0.43 put the entry inside a step
+// (x0 = 0.5: on a step boundary). The entry is found by Newton: the crossing (region 0 replacing
+// region 1) fails its signs, the sliding candidate (region 0 added) has theta = (1/2, 1/2); the
+// steps after it stay in the sliding mode by Newton. No NLP at all; same switch time and x(T) as
+// the homotopy path to 1e-9 (piecewise linear: both exact up to round-off).
+class ActiveSetSlidingEntry : public ::testing::TestWithParam<double> {};
+TEST_P(ActiveSetSlidingEntry, ByNewtonSameAsHomotopy) {
+  const double x0 = GetParam();
+  const Both b = run_file("sliding.toml", {{"x0", std::to_string(x0)}});
   expect_same(b, 1e-9);
   ASSERT_EQ(b.active.switches.size(), 1u);
-  EXPECT_NEAR(b.active.switches[0].t, 0.5, 1e-9);
-  EXPECT_EQ(b.active.summary.homotopy_path_steps, 1);
-  EXPECT_EQ(b.active.summary.active_set_path_steps, q.N_sim - 1);
+  EXPECT_NEAR(b.active.switches[0].t, x0, 1e-9);
+  EXPECT_EQ(b.active.switches[0].before, (std::vector<int>{1}));
+  EXPECT_EQ(b.active.switches[0].after, (std::vector<int>{0, 1}));
+  EXPECT_NEAR(b.active.x_final()[0], 0.0, 1e-9);
+  const fesd::Summary& s = b.active.summary;
+  EXPECT_EQ(s.active_set_path_steps, 10);
+  EXPECT_EQ(s.homotopy_path_steps, 0);
+  EXPECT_EQ(s.homotopy_steps, 0);  // no NLP
+  // One square system per step; in the step of the entry the crossing, then the sliding entry.
+  EXPECT_EQ(s.active_set_tries, 10 + 2);
+  // Sliding: theta = (1/2, 1/2) at every stage after the entry (Filippov's convex combination).
+  for (std::size_t i = 0; i < b.active.t_stage.size(); ++i)
+    if (b.active.t_stage[i] > x0 + 1e-9) {
+      EXPECT_NEAR(b.active.theta[i][0], 0.5, 1e-9) << "t = " << b.active.t_stage[i];
+      EXPECT_NEAR(b.active.theta[i][1], 0.5, 1e-9) << "t = " << b.active.t_stage[i];
+    }
+}
+INSTANTIATE_TEST_SUITE_P(X0, ActiveSetSlidingEntry, ::testing::Values(0.5, 0.47, 0.43));
+
+// Example 3(c) (examples/leaving_sliding.toml, x' in -sign(x) + t, x0 = 0, on [0, 2]): slides
+// until t = 1, then x = (t - 1)^2 / 2, x(2) = 1/2 (REFERENCE.md). N_sim = 7 puts the exit inside
+// the step [6/7, 8/7]: theta_0 < 0 in the prediction, the exit is pinned (theta_0 = 0 at the
+// boundary replaces h_1 = h_0). N_sim = 10: the exit on a step boundary. No NLP; the exit time
+// and x(T) as the homotopy path's (with its pinned re-solve) and exact, to 1e-9 (Radau IIA 2 is
+// exact for the quadratic).
+class ActiveSetSlidingExit : public ::testing::TestWithParam<int> {};
+TEST_P(ActiveSetSlidingExit, ByNewtonSameAsHomotopy) {
+  const int N_sim = GetParam();
+  const Both b = run_file("leaving_sliding.toml", {{"N_sim", std::to_string(N_sim)}});
+  expect_same(b, 1e-9);
+  ASSERT_EQ(b.active.switches.size(), 1u);
+  EXPECT_NEAR(b.active.switches[0].t, 1.0, 1e-9);
+  EXPECT_TRUE(b.active.switches[0].located);
+  EXPECT_EQ(b.active.switches[0].before, (std::vector<int>{0, 1}));
+  EXPECT_EQ(b.active.switches[0].after, (std::vector<int>{1}));
+  EXPECT_NEAR(b.active.x_final()[0], 0.5, 1e-9);
+  const fesd::Summary& s = b.active.summary;
+  EXPECT_EQ(s.active_set_path_steps, N_sim);
+  EXPECT_EQ(s.homotopy_path_steps, 0);
+  EXPECT_EQ(s.homotopy_steps, 0);
+  // One square system per step, one more for the exit: pinned at boundary 1 (N_sim = 7), or the
+  // whole step without region 0 (N_sim = 10: theta_0 < 0 at the step's first stage).
+  EXPECT_EQ(s.active_set_tries, N_sim + 1);
+}
+INSTANTIATE_TEST_SUITE_P(NSim, ActiveSetSlidingExit, ::testing::Values(7, 10));
+
+// Co-dimension 2 in a Cartesian product (docs/problem-files.md): x1' in -sign(x1), x2' in
+// -sign(x2) from (1, -2): x1 reaches 0 at t = 1 and slides (subsystem 0: {0} -> {0, 1}), x2 at
+// t = 2 (subsystem 1: {3} -> {2, 3}), then both stay at 0. Each subsystem's theta is determined
+// by its own surface: the square system is regular. N_sim = 7 on [0, 3] puts both entries inside
+// steps. No NLP; exact to 1e-9 and as the homotopy path.
+TEST(ActiveSetSliding, CodimensionTwoInACartesianProduct) {
+  const std::string text = R"(
+[model]
+x = ["x1", "x2"]
+x0 = [1, -2]
+[[model.subsystem]]
+c = ["x1"]
+F = [["-1", "0"], ["1", "0"]]
+[[model.subsystem]]
+g = ["-x2", "x2"]
+F = [["0", "-1"], ["0", "1"]]
+[simulation]
+T_sim = 3.0
+N_sim = 7
+[discretization]
+rk_scheme = "radau_iia"
+n_s = 2
+N_finite_elements = 2
+)";
+  fesd::SimulationProblem q = fesd::parse_simulation_problem(text, "product.toml");
+  const Both b = run_both(q.model, q.x0, q.T_sim, q.N_sim, q.options);
+  expect_same(b, 1e-9);
+  ASSERT_EQ(b.active.switches.size(), 2u);
+  EXPECT_NEAR(b.active.switches[0].t, 1.0, 1e-9);
+  EXPECT_NEAR(b.active.switches[1].t, 2.0, 1e-9);
+  EXPECT_EQ(b.active.switches[0].after, (std::vector<int>{0, 1, 3}));
+  EXPECT_EQ(b.active.switches[1].after, (std::vector<int>{0, 1, 2, 3}));
+  EXPECT_LT(b.active.x_final().lpNorm<Eigen::Infinity>(), 1e-9);
+  EXPECT_EQ(b.active.summary.active_set_path_steps, 7);
+  EXPECT_EQ(b.active.summary.homotopy_path_steps, 0);
+}
+
+// examples/temperature_control.toml (nosnoc_py's hysteresis example, 4 regions in one subsystem,
+// time freezing): the sliding entries {2} -> {2, 3} at t = 0.5 and 2.6 are taken by Newton. At
+// the triple point psi = 1, w = 0 region 1's field is 0 (a Filippov equilibrium): the sliding
+// candidate {0, 1, 2} there has theta = (0, 1, 0), on the simplex boundary, and is refused
+// (sliding_is_filippov); those steps fall back to the homotopy, whose relaxed homotopy (sigma_N
+// = 1e-2) carries the state over the equilibrium. The file's complementarity_tol is 1e-2: the
+// homotopy path's exact re-solves leave its switch at 2.6 3.9e-7 early (its element starts
+// sliding at w = 1 - 9.8e-7), so the paths agree to 1e-6 in the switch times, 1e-7 in x(T).
+TEST(ActiveSetSliding, TemperatureControlSameAsHomotopy) {
+  const Both b = run_file("temperature_control.toml");
+  expect_same(b, 1e-6);
+  EXPECT_LT((b.active.x_final() - b.homotopy.x_final()).lpNorm<Eigen::Infinity>(), 1e-7);
+  ASSERT_EQ(b.active.switches.size(), 7u);
+  EXPECT_NEAR(b.active.switches[1].t, 0.5, 1e-9);
+  EXPECT_GE(b.active.summary.active_set_path_steps, 25);
+  EXPECT_LE(b.active.summary.homotopy_path_steps, 5);
+}
+
+// examples/periodic_stick_slip.toml (nosnoc_py's codim-2 example: one subsystem, four regions of
+// c = (x2 - 0.2, x3 - 0.4), Radau IIA n_s = 4, N_FE = 3, N_sim = 100 on [0, 20]). On the
+// intersection of both surfaces f_0 = f_1, so the four-region set has a one-parameter family of
+// theta: its system is not square. Every step runs on the active-set path with the regular
+// selection {0, 3} (theta_1 = theta_2 = 0: ActiveSetStep::selections, the two-region sets of an
+// entry), and the switches are the 7 events of the event-driven solution (the file's comment;
+// here to 10 digits from an RK4 integration with step 1e-3 and 5e-4, events by bisection, which
+// agree to 1e-12), x(20) = (1.22894361753, -0.260185061673, -0.0601850616733) from it. The
+// homotopy path (66 s CPU, not run here) lists 17 switches on this grid: 10 more than the events
+// (changes between {1, 3}, {0, 1, 3} and {0, 1, 2, 3} on the intersection, short visits of region
+// 1 at entries and exits), and its x(20) is 3.2e-4 off.
+TEST(ActiveSetSliding, StickSlipCodimensionTwoEvents) {
+  fesd::SimulationProblem q =
+      fesd::load_simulation_problem(FESD_SOURCE_DIR "/examples/periodic_stick_slip.toml");
+  fesd::apply_override(q, "step_solver", "active_set");
+  const IntegratorResult r = fesd::integrate(q.model, q.x0, q.T_sim, q.N_sim, q.options, q.u, q.p);
+  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+  EXPECT_EQ(r.summary.active_set_path_steps, 100);
+  EXPECT_EQ(r.summary.homotopy_path_steps, 0);
+  const double events[] = {0.2443307896,  0.5549932425,  2.7880473074, 7.5239056551,
+                           10.6157314133, 15.3515897609, 18.4434155192};
+  ASSERT_EQ(r.switches.size(), 7u);
+  for (std::size_t i = 0; i < 7; ++i) {
+    EXPECT_NEAR(r.switches[i].t, events[i], 1e-8) << "switch " << i;
+    EXPECT_TRUE(r.switches[i].located);
+  }
+  EXPECT_EQ(r.switches[1].after, (std::vector<int>{0, 3}));  // both surfaces: the selection
+  const Eigen::Vector3d x_ref(1.22894361753, -0.260185061673, -0.0601850616733);
+  EXPECT_LT((r.x_final() - x_ref).lpNorm<Eigen::Infinity>(), 1e-8);
 }
 
 TEST(ActiveSetOptions, UnknownValueIsAClearError) {
