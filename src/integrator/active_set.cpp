@@ -251,6 +251,41 @@ ActiveSetTry ActiveSetStep::newton(const Sets& active, const std::vector<nlp::Bo
     lb_[bd.var] = bd.lb;
     ub_[bd.var] = bd.ub;
   }
+  // Schemes that are not stiffly accurate (Gauss-Legendre): the end point x_{n+1} of an element is
+  // not a stage, and its boundary LP (33) has its own lambda_end, mu_end. In a sliding element
+  // (m >= 2 regions of subsystem k active) lambda_end = 0 for all m would make the LP at x_{n+1}
+  // m rows in one unknown mu_end: c(x_{n+1}) = 0 on top of c = 0 at the n_s stages, which already
+  // imply it (for an affine c exactly: c(X_s) = 0 for all s and c(x_n) = 0 give grad c . V_s = 0,
+  // A being regular, so c(x_{n+1}) = 0). As at the step start (FesdInterval::active_set_bounds),
+  // all but the first of them stay free there, without a sign bound (O(h^p) of either sign for a
+  // curved surface), where the element after has the same regions of k (or n is the last element).
+  // At an entry (the element after slides, this one does not) the fixed lambda is the switch
+  // condition and stays.
+  for (int n = 0; n < N; ++n) {
+    if (iv.lambda_end(n, 0) < 0 || iv.lambda_end(n, 0) == iv.lambda(n, iv.n_s() - 1, 0)) continue;
+    for (int k = 0; k < model_.n_sys(); ++k) {
+      const int first = model_.region_offset(k), end = model_.region_offset(k + 1);
+      const auto in_k = [&](const std::vector<int>& a) {
+        return std::count_if(a.begin(), a.end(), [&](int r) { return r >= first && r < end; });
+      };
+      if (in_k(active[n]) < 2) continue;
+      bool same_after = true;
+      if (n + 1 < N)
+        for (int r = first; r < end; ++r)
+          same_after = same_after &&
+                       discretization::has(active[n], r) == discretization::has(active[n + 1], r);
+      if (!same_after) continue;
+      bool first_kept = false;
+      for (int r : active[n]) {
+        if (r < first || r >= end) continue;
+        if (first_kept) {
+          lb_[iv.lambda_end(n, r)] = -nlp::kInf;
+          ub_[iv.lambda_end(n, r)] = nlp::kInf;
+        }
+        first_kept = true;
+      }
+    }
+  }
   for (const nlp::Bound& bd : extra) {  // a sliding exit: theta_r = 0 at the boundary
     lb_[bd.var] = bd.lb;
     ub_[bd.var] = bd.ub;
