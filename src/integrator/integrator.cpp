@@ -186,11 +186,19 @@ class Integrator {
   /// whole step (nothing of it is kept).
   bool active_set_step() {
     const auto t0 = Clock::now();
-    PieceStart start{x_, res_.active_set.empty() ? lp_active_set(guess_) : res_.active_set.back(),
-                     guess_, guess_xdot_};
-    pieces_.clear();
-    const bool ok = solve_pieces(0, start);
     Summary& sum = res_.summary;
+    integrator::ActiveSetStep& as = *active_;
+    // The whole step (no copies: most steps end here), then its pieces.
+    bool ok = res_.active_set.empty() ? as.solve(x_, lp_active_set(guess_), guess_, guess_xdot_)
+                                      : as.solve(x_, res_.active_set.back(), guess_, guess_xdot_);
+    sum.newton_iterations += as.newton_iterations();
+    sum.active_set_tries += as.tries();
+    pieces_.clear();
+    if (!ok) {
+      PieceStart start{x_, res_.active_set.empty() ? lp_active_set(guess_) : res_.active_set.back(),
+                       guess_, guess_xdot_};
+      ok = solve_pieces(1, start) && solve_pieces(1, start);
+    }
     sum.active_set_s += seconds_since(t0);
     if (!ok) return false;
     ++sum.active_set_path_steps;
@@ -198,6 +206,12 @@ class Integrator {
     last_.status = Status::Success;
     last_.active_set_fixed = true;
     res_.homotopy.emplace_back();  // no NLPs: the step's homotopy table is empty
+    if (pieces_.empty()) {
+      last_.comp_residual =
+          mpcc::comp_residual(as.solution().data(), as.interval().residual_pairs());
+      commit(as.interval(), as.solution(), last_.comp_residual, {});
+      return true;
+    }
     for (const Piece& piece : pieces_) {
       const discretization::FesdInterval& iv = active_level(piece.level).interval();
       const double comp = mpcc::comp_residual(piece.w.data(), iv.residual_pairs());
