@@ -5,11 +5,13 @@
 // Example 3(a) (x' in 2 - sign(x), x0 = -1, T = 1.9), and the sliding modes of the second slice:
 // Example 3(b) (x' in -sign(x), x0 = 0.47, T = 1: enters sliding at t = 0.47, x(T) = 0) and
 // Example 3(c) (x' in -sign(x) + t, x0 = 0, T = 1.9: leaves at t = 1, x(T) = 0.9^2 / 2; the time as
-// a second state), integrated with step_solver = homotopy and
+// a second state), and the Cartesian product of docs/problem-files.md (x1' in -sign(x1), x2' in
+// -sign(x2) from (1, -2), T = 3: sliding entries at t = 1 and 2, co-dimension 2 after, x(T) = 0),
+// integrated with step_solver = homotopy and
 // step_solver = active_set in one process: per path the median over R repetitions of the time of
 // integrate() (in-process wall time and this process's CPU time), per step, the Newton iterations
 // and the IPOPT iterations per step, the steps each path solved, the error of x(T) against the
-// exact value and of the switch time.
+// exact value and of the switch times (the largest).
 //
 //   active_set_step [--N 40] [--repeat R] [--repeat-active RA] [--csv FILE] [--json FILE]
 #include <algorithm>
@@ -68,11 +70,28 @@ struct LeavingModel {
   }
 };
 
+/// The Cartesian product of docs/problem-files.md: x1' in -sign(x1), x2' in -sign(x2), two
+/// subsystems (regions 0, 1: x1 > 0, < 0; 2, 3: x2 > 0, < 0). From (1, -2): x1 reaches 0 at t = 1
+/// and slides, x2 at t = 2 (co-dimension 2 from then on), x(3) = 0.
+struct ProductModel {
+  template <class T>
+  void c(const T* x, const T*, T* c) const {
+    c[0] = x[0];
+    c[1] = x[1];
+  }
+  template <class T>
+  void f(int region, const T*, const T*, const T*, T* f) const {
+    f[0] = T(region == 0 ? -1.0 : region == 1 ? 1.0 : 0.0);
+    f[1] = T(region == 2 ? -1.0 : region == 3 ? 1.0 : 0.0);
+  }
+};
+
 struct Case {
   std::string name;
   fesd::Pss model;
   Eigen::VectorXd x0, x_exact;
-  double T = 0, t_s = 0;
+  double T = 0;
+  std::vector<double> t_s;  // the exact switch times
   int n_s = 3;
 };
 
@@ -129,7 +148,12 @@ Row measure(const Case& c, int N_sim, fesd::StepSolver solver, int repeats) {
   row.homotopy_steps = s.homotopy_path_steps;
   row.tries = s.active_set_tries;
   row.error_x = r.status == fesd::Status::Success ? (r.x_final() - c.x_exact).norm() : NAN;
-  row.error_t_s = r.switches.size() == 1 ? std::abs(r.switches[0].t - c.t_s) : NAN;
+  row.error_t_s = NAN;
+  if (r.switches.size() == c.t_s.size()) {
+    row.error_t_s = 0;
+    for (std::size_t i = 0; i < c.t_s.size(); ++i)
+      row.error_t_s = std::max(row.error_t_s, std::abs(r.switches[i].t - c.t_s[i]));
+  }
   return row;
 }
 
@@ -158,24 +182,50 @@ int main(int argc, char** argv) {
   }
 
   std::vector<Case> cases;
-  cases.push_back({"oscillator (47)", fesd_bench::oscillator_model(), fesd_bench::oscillator_x0(),
-                   fesd_bench::oscillator_exact_xT(), fesd_bench::kOscillatorT,
-                   fesd_bench::kOscillatorSwitch, 3});
+  cases.push_back({"oscillator (47)",
+                   fesd_bench::oscillator_model(),
+                   fesd_bench::oscillator_x0(),
+                   fesd_bench::oscillator_exact_xT(),
+                   fesd_bench::kOscillatorT,
+                   {fesd_bench::kOscillatorSwitch},
+                   3});
   cases.push_back(
       {"Example 3(a)",
        fesd::make_pss(fesd_bench::SensitivityModel{},
                       fesd::PssDims{.n_x = 1, .subsystems = {fesd::Subsystem::from_c(1)}}),
-       Eigen::VectorXd::Constant(1, -1.0), Eigen::VectorXd::Constant(1, 1.9 - 1.0 / 3.0), 1.9,
-       1.0 / 3.0, 3});
+       Eigen::VectorXd::Constant(1, -1.0),
+       Eigen::VectorXd::Constant(1, 1.9 - 1.0 / 3.0),
+       1.9,
+       {1.0 / 3.0},
+       3});
 
   const fesd::PssDims one_c{.n_x = 1, .subsystems = {fesd::Subsystem::from_c(1)}};
-  cases.push_back({"Example 3(b)", fesd::make_pss(SlidingModel{}, one_c),
-                   Eigen::VectorXd::Constant(1, 0.47), Eigen::VectorXd::Zero(1), 1.0, 0.47, 3});
+  cases.push_back({"Example 3(b)",
+                   fesd::make_pss(SlidingModel{}, one_c),
+                   Eigen::VectorXd::Constant(1, 0.47),
+                   Eigen::VectorXd::Zero(1),
+                   1.0,
+                   {0.47},
+                   3});
   cases.push_back(
       {"Example 3(c)",
        fesd::make_pss(LeavingModel{},
                       fesd::PssDims{.n_x = 2, .subsystems = {fesd::Subsystem::from_c(1)}}),
-       Eigen::VectorXd::Zero(2), Eigen::Vector2d(0.5 * 0.9 * 0.9, 1.9), 1.9, 1.0, 3});
+       Eigen::VectorXd::Zero(2),
+       Eigen::Vector2d(0.5 * 0.9 * 0.9, 1.9),
+       1.9,
+       {1.0},
+       3});
+  cases.push_back(
+      {"Cartesian prod.",
+       fesd::make_pss(ProductModel{}, fesd::PssDims{.n_x = 2,
+                                                    .subsystems = {fesd::Subsystem::from_c(1),
+                                                                   fesd::Subsystem::from_c(1)}}),
+       Eigen::Vector2d(1.0, -2.0),
+       Eigen::VectorXd::Zero(2),
+       3.0,
+       {1.0, 2.0},
+       3});
 
   std::vector<Row> rows;
   for (const Case& c : cases) {

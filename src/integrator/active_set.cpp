@@ -93,19 +93,29 @@ bool ActiveSetStep::solve(const Eigen::VectorXd& x0, const std::vector<int>& pre
 
   // The prediction, then (if its system is not square or singular) the selections of a
   // co-dimension-2 sliding mode (selections()).
-  std::vector<int> predicted;
-  const std::vector<double> w_guess = w_;
-  for (const std::vector<int>& set : selections(prediction, lp)) {
-    if (tries_ >= kMaxTries) return false;
-    w_ = w_guess;
-    ++tries_;
-    if (newton(Sets(iv_->N_FE(), set)).converged) {
-      predicted = set;
-      break;
+  predicted_.clear();
+  w_guess_ = w_;
+  ++tries_;
+  sets_.assign(iv_->N_FE(), prediction);
+  if (newton(sets_).converged) {
+    predicted_ = prediction;
+  } else {
+    const std::vector<std::vector<int>> sel = selections(prediction, lp);
+    for (std::size_t i = 1; i < sel.size(); ++i) {
+      if (tries_ >= kMaxTries) return false;
+      w_ = w_guess_;
+      ++tries_;
+      sets_.assign(iv_->N_FE(), sel[i]);
+      if (newton(sets_).converged) {
+        predicted_ = sel[i];
+        break;
+      }
     }
   }
-  if (predicted.empty()) return false;
-  const Sets predicted_sets(iv_->N_FE(), predicted);
+  if (predicted_.empty()) return false;
+  const std::vector<int>& predicted = predicted_;
+  predicted_sets_.assign(iv_->N_FE(), predicted);
+  const Sets& predicted_sets = predicted_sets_;
   const Violation v = check_signs(predicted_sets);
   if (v.bad) return false;
   if (v.r < 0) return true;
@@ -244,47 +254,21 @@ bool ActiveSetStep::sliding_is_filippov(const Sets& active, int k, int b) const 
 
 ActiveSetTry ActiveSetStep::newton(const Sets& active, const std::vector<nlp::Bound>& extra) {
   const discretization::FesdInterval& iv = *iv_;
-  const int N = iv.N_FE();
-  lb_ = nlp_.x_lb;
-  ub_ = nlp_.x_ub;
-  for (const nlp::Bound& bd : iv.active_set_bounds(active)) {
-    lb_[bd.var] = bd.lb;
-    ub_[bd.var] = bd.ub;
-  }
-  for (const nlp::Bound& bd : extra) {  // a sliding exit: theta_r = 0 at the boundary
-    lb_[bd.var] = bd.lb;
-    ub_[bd.var] = bd.ub;
-  }
-  free_.clear();
-  col_of_.assign(lb_.size(), -1);
-  for (std::size_t j = 0; j < lb_.size(); ++j) {
-    if (lb_[j] < ub_[j]) {
-      col_of_[j] = static_cast<int>(free_.size());
-      free_.push_back(static_cast<int>(j));
-    } else {
-      w_[j] = lb_[j];
-    }
-  }
-  // h_n = h_{n-1} where the active set does not change; at a switch the boundary's length is
-  // free and the switch condition takes its row: lambda = 0 of both regions there (a crossing,
-  // a sliding entry; fixed above), or theta_r = 0 of the leaving region (an exit: the pin).
-  std::vector<int> equal;
-  for (int n = 1; n < N; ++n)
-    if (active[n] == active[n - 1]) equal.push_back(n);
+  if (!shape_valid_ || !same_shape(active, extra)) restrict_to(active, extra);
+  // the start state (the only bounds that change between steps of one shape)
+  for (int j : in_.s0) lb_[j] = ub_[j] = nlp_.x_lb[j];
+  for (int j : fixed_) w_[j] = lb_[j];
   const int m = nlp_.num_constraints();
-  const int n_eq = m + static_cast<int>(equal.size());
+  const int n_eq = m + static_cast<int>(equal_.size());
   const int n_free = static_cast<int>(free_.size());
   ActiveSetTry out;
   if (n_eq != n_free) return out;  // not square: a shape the active-set path does not handle
-  J_.resize(n_free, n_free);
-  F_.resize(n_free);
-  const std::vector<int>& rows = nlp_.jac_rows();
-  const std::vector<int>& cols = nlp_.jac_cols();
+  double* J = J_.data();
   for (int it = 0; it < kMaxNewton; ++it) {
     if (!nlp_.eval_g(w_.data(), g_.data())) return out;
     for (int i = 0; i < m; ++i) F_[i] = g_[i] - nlp_.g_lb[i];
-    for (std::size_t e = 0; e < equal.size(); ++e)
-      F_[m + static_cast<int>(e)] = w_[iv.h(equal[e])] - w_[iv.h(equal[e] - 1)];
+    for (std::size_t e = 0; e < equal_.size(); ++e)
+      F_[m + static_cast<int>(e)] = w_[iv.h(equal_[e])] - w_[iv.h(equal_[e] - 1)];
     double w_max = 1;
     for (int j : free_) w_max = std::max(w_max, std::abs(w_[j]));
     if (F_.lpNorm<Eigen::Infinity>() <= 1e-13 * w_max) {
@@ -292,20 +276,17 @@ ActiveSetTry ActiveSetStep::newton(const Sets& active, const std::vector<nlp::Bo
       return out;
     }
     if (!nlp_.eval_jac_g(w_.data(), jac_.data())) return out;
-    J_.setZero();
-    for (std::size_t e = 0; e < jac_.size(); ++e)
-      if (const int c = col_of_[cols[e]]; c >= 0) J_(rows[e], c) += jac_[e];
-    for (std::size_t e = 0; e < equal.size(); ++e) {
-      J_(m + static_cast<int>(e), col_of_[iv.h(equal[e])]) = 1;
-      J_(m + static_cast<int>(e), col_of_[iv.h(equal[e] - 1)]) = -1;
-    }
-    const Eigen::PartialPivLU<Eigen::MatrixXd> lu(J_);
-    dz_ = lu.solve(-F_);
+    // the restricted Jacobian: the entries of free columns (zeroed first: an entry may be the sum
+    // of several); the equal-length rows are constant (restrict_to)
+    for (const auto& [e, pos] : jac_map_) J[pos] = 0;
+    for (const auto& [e, pos] : jac_map_) J[pos] += jac_[e];
+    lu_.compute(J_);
+    dz_ = lu_.solve(-F_);
     ++out.iterations;
     ++iterations_;
     // A singular Jacobian (not square in effect): the smallest pivot of the LU against the
     // largest. Cheaper than rcond(), whose estimate costs more than the factorization here.
-    const auto pivots = lu.matrixLU().diagonal().cwiseAbs();
+    const auto pivots = lu_.matrixLU().diagonal().cwiseAbs();
     if (!dz_.allFinite() || !(pivots.minCoeff() > 1e-14 * pivots.maxCoeff())) return out;
     for (int i = 0; i < n_free; ++i) w_[free_[i]] += dz_[i];
     if (dz_.lpNorm<Eigen::Infinity>() <= 1e-14 * w_max) {
@@ -314,6 +295,100 @@ ActiveSetTry ActiveSetStep::newton(const Sets& active, const std::vector<nlp::Bo
     }
   }
   return out;
+}
+
+bool ActiveSetStep::same_shape(const Sets& active, const std::vector<nlp::Bound>& extra) const {
+  if (active != shape_ || extra.size() != shape_extra_.size()) return false;
+  for (std::size_t i = 0; i < extra.size(); ++i)
+    if (extra[i].var != shape_extra_[i].var || extra[i].lb != shape_extra_[i].lb ||
+        extra[i].ub != shape_extra_[i].ub)
+      return false;
+  return true;
+}
+
+void ActiveSetStep::restrict_to(const Sets& active, const std::vector<nlp::Bound>& extra) {
+  const discretization::FesdInterval& iv = *iv_;
+  const int N = iv.N_FE();
+  shape_ = active;
+  shape_extra_ = extra;
+  shape_valid_ = true;
+  lb_ = nlp_.x_lb;
+  ub_ = nlp_.x_ub;
+  for (const nlp::Bound& bd : iv.active_set_bounds(active)) {
+    lb_[bd.var] = bd.lb;
+    ub_[bd.var] = bd.ub;
+  }
+  // Schemes that are not stiffly accurate (Gauss-Legendre): the end point x_{n+1} of an element is
+  // not a stage, and its boundary LP (33) has its own lambda_end, mu_end. In a sliding element
+  // (m >= 2 regions of subsystem k active) lambda_end = 0 for all m would make the LP at x_{n+1}
+  // m rows in one unknown mu_end: c(x_{n+1}) = 0 on top of c = 0 at the n_s stages, which already
+  // imply it (for an affine c exactly: c(X_s) = 0 for all s and c(x_n) = 0 give grad c . V_s = 0,
+  // A being regular, so c(x_{n+1}) = 0). As at the step start (FesdInterval::active_set_bounds),
+  // all but the first of them stay free there, without a sign bound (O(h^p) of either sign for a
+  // curved surface), where the element after has the same regions of k (or n is the last element).
+  // At an entry (the element after slides, this one does not) the fixed lambda is the switch
+  // condition and stays.
+  for (int n = 0; n < N; ++n) {
+    if (iv.lambda_end(n, 0) < 0 || iv.lambda_end(n, 0) == iv.lambda(n, iv.n_s() - 1, 0)) continue;
+    for (int k = 0; k < model_.n_sys(); ++k) {
+      const int first = model_.region_offset(k), end = model_.region_offset(k + 1);
+      const auto in_k = [&](const std::vector<int>& a) {
+        return std::count_if(a.begin(), a.end(), [&](int r) { return r >= first && r < end; });
+      };
+      if (in_k(active[n]) < 2) continue;
+      bool same_after = true;
+      if (n + 1 < N)
+        for (int r = first; r < end; ++r)
+          same_after = same_after &&
+                       discretization::has(active[n], r) == discretization::has(active[n + 1], r);
+      if (!same_after) continue;
+      bool first_kept = false;
+      for (int r : active[n]) {
+        if (r < first || r >= end) continue;
+        if (first_kept) {
+          lb_[iv.lambda_end(n, r)] = -nlp::kInf;
+          ub_[iv.lambda_end(n, r)] = nlp::kInf;
+        }
+        first_kept = true;
+      }
+    }
+  }
+  for (const nlp::Bound& bd : extra) {  // a sliding exit: theta_r = 0 at the boundary
+    lb_[bd.var] = bd.lb;
+    ub_[bd.var] = bd.ub;
+  }
+  free_.clear();
+  fixed_.clear();
+  col_of_.assign(lb_.size(), -1);
+  for (std::size_t j = 0; j < lb_.size(); ++j) {
+    if (lb_[j] < ub_[j]) {
+      col_of_[j] = static_cast<int>(free_.size());
+      free_.push_back(static_cast<int>(j));
+    } else {
+      fixed_.push_back(static_cast<int>(j));
+    }
+  }
+  // h_n = h_{n-1} where the active set does not change; at a switch the boundary's length is
+  // free and the switch condition takes its row: lambda = 0 of both regions there (a crossing,
+  // a sliding entry; fixed above), or theta_r = 0 of the leaving region (an exit: the pin).
+  equal_.clear();
+  for (int n = 1; n < N; ++n)
+    if (active[n] == active[n - 1]) equal_.push_back(n);
+  const int m = nlp_.num_constraints();
+  const int n_free = static_cast<int>(free_.size());
+  if (m + static_cast<int>(equal_.size()) != n_free) return;  // not square: newton() says so
+  J_.setZero(n_free, n_free);
+  F_.resize(n_free);
+  const std::vector<int>& rows = nlp_.jac_rows();
+  const std::vector<int>& cols = nlp_.jac_cols();
+  jac_map_.clear();
+  for (std::size_t e = 0; e < jac_.size(); ++e)
+    if (const int c = col_of_[cols[e]]; c >= 0)
+      jac_map_.emplace_back(static_cast<int>(e), rows[e] + n_free * c);
+  for (std::size_t e = 0; e < equal_.size(); ++e) {
+    J_(m + static_cast<int>(e), col_of_[iv.h(equal_[e])]) = 1;
+    J_(m + static_cast<int>(e), col_of_[iv.h(equal_[e] - 1)]) = -1;
+  }
 }
 
 ActiveSetStep::Violation ActiveSetStep::check_signs(const Sets& active) const {
@@ -332,7 +407,10 @@ ActiveSetStep::Violation ActiveSetStep::check_signs(const Sets& active) const {
   // region; in a set with one region of its subsystem theta is 1), lambda >= 0 off it (an entry);
   // per region the last point where its sign held.
   // Before the first stage: theta at the step start (the end of the step before).
-  std::vector<double> t_ok(n_th, 0.0), val_ok(n_th, 0.0);
+  t_ok_.assign(n_th, 0.0);
+  val_ok_.assign(n_th, 0.0);
+  std::vector<double>& t_ok = t_ok_;
+  std::vector<double>& val_ok = val_ok_;
   for (int r : active[0]) val_ok[r] = std::max(theta_start_[r], 0.0);
   const auto violated = [&](int r, double t, double val, bool exit) {
     v.r = r;

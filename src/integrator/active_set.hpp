@@ -21,6 +21,7 @@
 // is reduced to a regular selection (selections()). If no consistent active set is found within
 // kMaxTries square systems, solve() returns false and the integrator uses the homotopy.
 #pragma once
+#include <utility>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -134,13 +135,30 @@ class ActiveSetStep {
   discretization::IntervalInputs in_;
   std::unique_ptr<discretization::FesdInterval> iv_;
   std::vector<double> w_;
-  // per square system: the free variables (column map), bounds with the active set applied
-  std::vector<int> free_, col_of_;
+  /// Sets up the square system of a shape (active sets and extra bounds): the bounds with the
+  /// active set applied, the free variables (column map), the fixed ones, the equal-length rows,
+  /// where each Jacobian entry goes in the dense matrix. Done once per shape: newton() with the
+  /// shape of the call before (most steps: the prediction, as the step before) only refreshes s0.
+  void restrict_to(const Sets& active, const std::vector<nlp::Bound>& extra);
+  bool same_shape(const Sets& active, const std::vector<nlp::Bound>& extra) const;
+
+  // per square system (shape): the free variables (column map), bounds with the active set applied
+  Sets shape_;
+  std::vector<nlp::Bound> shape_extra_;
+  bool shape_valid_ = false;
+  std::vector<int> free_, col_of_, fixed_, equal_;
+  std::vector<std::pair<int, int>> jac_map_;  // (Jacobian entry, index into J_'s storage)
   std::vector<double> lb_, ub_;
   Eigen::MatrixXd J_;
+  Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
   Eigen::VectorXd F_, dz_;
   std::vector<double> g_, jac_;
   Eigen::VectorXd theta_start_;  // theta at the step start (the guess's LP): exit times
+  // work space of solve() and check_signs(), kept between steps (no allocation once sized)
+  std::vector<double> w_guess_;
+  std::vector<int> predicted_;
+  Sets sets_, predicted_sets_;
+  mutable std::vector<double> t_ok_, val_ok_;
   int iterations_ = 0, tries_ = 0;
   Kind kind_ = Kind::Prediction;
 };

@@ -178,28 +178,95 @@ class Integrator {
   // ---- the active-set path (step_solver = active_set; docs/active-set.md) ----
 
   /// The step by Newton's method on the square system of the active set predicted from the end
-  /// of the step before (the LP at x0 for the first), with a crossing located where the signs
-  /// fail. False: no consistent active set found, the homotopy takes the step.
+  /// of the step before (the LP at x0 for the first), with a switch located where the signs
+  /// fail. Where no consistent active set is found for the whole step (e.g. two switches closer
+  /// together than N_FE element boundaries allow: a short slide of the relay), the step is solved
+  /// as two half steps of N_FE elements each, and each of those that fails as two quarter steps,
+  /// every piece on the active-set path. False: some piece failed too; the homotopy takes the
+  /// whole step (nothing of it is kept).
   bool active_set_step() {
     const auto t0 = Clock::now();
-    integrator::ActiveSetStep& as = *active_;
-    const std::vector<int> predicted =
-        res_.active_set.empty() ? lp_active_set(guess_) : res_.active_set.back();
-    const bool ok = as.solve(x_, predicted, guess_, guess_xdot_);
     Summary& sum = res_.summary;
+    integrator::ActiveSetStep& as = *active_;
+    // The whole step (no copies: most steps end here), then its pieces.
+    bool ok = res_.active_set.empty() ? as.solve(x_, lp_active_set(guess_), guess_, guess_xdot_)
+                                      : as.solve(x_, res_.active_set.back(), guess_, guess_xdot_);
     sum.newton_iterations += as.newton_iterations();
     sum.active_set_tries += as.tries();
+    pieces_.clear();
+    if (!ok) {
+      PieceStart start{x_, res_.active_set.empty() ? lp_active_set(guess_) : res_.active_set.back(),
+                       guess_, guess_xdot_};
+      ok = solve_pieces(1, start) && solve_pieces(1, start);
+    }
     sum.active_set_s += seconds_since(t0);
     if (!ok) return false;
     ++sum.active_set_path_steps;
-    const std::vector<double>& w = as.solution();
     last_ = {};
     last_.status = Status::Success;
     last_.active_set_fixed = true;
-    last_.comp_residual = mpcc::comp_residual(w.data(), as.interval().residual_pairs());
     res_.homotopy.emplace_back();  // no NLPs: the step's homotopy table is empty
-    commit(as.interval(), w, last_.comp_residual, {});
+    if (pieces_.empty()) {
+      last_.comp_residual =
+          mpcc::comp_residual(as.solution().data(), as.interval().residual_pairs());
+      commit(as.interval(), as.solution(), last_.comp_residual, {});
+      return true;
+    }
+    for (const Piece& piece : pieces_) {
+      const discretization::FesdInterval& iv = active_level(piece.level).interval();
+      const double comp = mpcc::comp_residual(piece.w.data(), iv.residual_pairs());
+      last_.comp_residual = std::max(last_.comp_residual, comp);
+      commit(iv, piece.w, comp, {});
+    }
     return true;
+  }
+
+  /// Where a piece of a step starts: the state, the predicted active set, the algebraic guess.
+  struct PieceStart {
+    Eigen::VectorXd x;
+    std::vector<int> predicted;
+    dcs::LpSolution lp;
+    Eigen::VectorXd xdot;
+  };
+  /// A solved piece of a step on the active-set path: level k (length T_step / 2^k), solution w.
+  struct Piece {
+    int level = 0;
+    std::vector<double> w;
+  };
+
+  /// The square-system solver of level k (steps of length T_step / 2^k), created when first used.
+  integrator::ActiveSetStep& active_level(int k) {
+    if (k == 0) return *active_;
+    std::unique_ptr<integrator::ActiveSetStep>& a = active_split_[static_cast<std::size_t>(k - 1)];
+    if (!a)
+      a = std::make_unique<integrator::ActiveSetStep>(model_, tab_, d_, T_step_ / (1 << k), u_, p_);
+    return *a;
+  }
+
+  /// Solves a piece of level k from `start` (advanced to its end on success) into pieces_; where
+  /// that fails, its two halves (down to level kMaxActiveSplit).
+  bool solve_pieces(int k, PieceStart& start) {
+    integrator::ActiveSetStep& as = active_level(k);
+    const bool ok = as.solve(start.x, start.predicted, start.lp, start.xdot);
+    Summary& sum = res_.summary;
+    sum.newton_iterations += as.newton_iterations();
+    sum.active_set_tries += as.tries();
+    if (ok) {
+      const discretization::FesdInterval& iv = as.interval();
+      const std::vector<double>& w = as.solution();
+      pieces_.push_back({k, w});
+      const int last = iv.N_FE() - 1, n_s = d_.n_s;
+      const int n_x = model_.n_x(), n_th = model_.n_theta(), n_sys = model_.n_sys();
+      for (int i = 0; i < n_x; ++i) start.x[i] = w[iv.x(last + 1, i)];
+      start.predicted = iv.active_set(w.data(), last);
+      start.lp.theta = gather(w, iv.theta(last, n_s - 1, 0), n_th);
+      start.lp.lambda = gather(w, iv.lambda(last, n_s - 1, 0), n_th);
+      start.lp.mu = gather(w, iv.mu(last, n_s - 1, 0), n_sys);
+      start.xdot = gather(w, iv.V(last, n_s - 1, 0), n_x);
+      return true;
+    }
+    if (k == kMaxActiveSplit) return false;
+    return solve_pieces(k + 1, start) && solve_pieces(k + 1, start);
   }
 
   /// The active regions of the LP solution at the start (theta above lambda and 1e-6), the
@@ -646,6 +713,10 @@ class Integrator {
   std::unique_ptr<nlp::NlpSolver> solver_;
   std::unique_ptr<nlp::NlpSolver> mumps_;              // the retries' solver with kkt_solver = auto
   std::unique_ptr<integrator::ActiveSetStep> active_;  // step_solver = active_set
+  /// Half and quarter steps of the active-set path (active_level()), and the pieces of a step.
+  static constexpr int kMaxActiveSplit = 2;
+  std::array<std::unique_ptr<integrator::ActiveSetStep>, kMaxActiveSplit> active_split_;
+  std::vector<Piece> pieces_;
 
   /// The NLP solver of the current attempt: once an attempt of the step has failed (careful_),
   /// and kkt_solver is auto, its retries factor the KKT systems with MUMPS, the fallback of the

@@ -1,6 +1,7 @@
 // step_solver = active_set (docs/active-set.md): Newton's method on the square system of Thm 15
 // gives the same x(T) and switch times as the homotopy path, with every step (or all but a counted
 // few) solved without IPOPT. Exact values from REFERENCE.md.
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <utility>
@@ -279,6 +280,119 @@ TEST(ActiveSetSliding, StickSlipCodimensionTwoEvents) {
   EXPECT_EQ(r.switches[1].after, (std::vector<int>{0, 3}));  // both surfaces: the selection
   const Eigen::Vector3d x_ref(1.22894361753, -0.260185061673, -0.0601850616733);
   EXPECT_LT((r.x_final() - x_ref).lpNorm<Eigen::Infinity>(), 1e-8);
+}
+
+// Two switches in one step: the Cartesian product from (1, -1.1), N_sim = 5 on [0, 3] (steps of
+// 0.6): x1 enters its sliding mode at t = 1, x2 at t = 1.1, both inside the step [0.6, 1.2],
+// whose N_FE = 2 elements have one free boundary. The homotopy path solves that step with 2 N_FE
+// elements (its refined retry); the active-set path as two half steps, the second of which,
+// [0.9, 1.2], has both switches too and runs as two quarter steps (entries at 1 and 1.1). Same
+// switches and x(T) to 1e-9, exact; every step by Newton.
+TEST(ActiveSetTwoSwitches, CartesianProductEntriesInOneStep) {
+  const std::string text = R"(
+[model]
+x = ["x1", "x2"]
+x0 = [1, -1.1]
+[[model.subsystem]]
+c = ["x1"]
+F = [["-1", "0"], ["1", "0"]]
+[[model.subsystem]]
+g = ["-x2", "x2"]
+F = [["0", "-1"], ["0", "1"]]
+[simulation]
+T_sim = 3.0
+N_sim = 5
+[discretization]
+rk_scheme = "radau_iia"
+n_s = 2
+N_finite_elements = 2
+)";
+  fesd::SimulationProblem q = fesd::parse_simulation_problem(text, "product.toml");
+  const Both b = run_both(q.model, q.x0, q.T_sim, q.N_sim, q.options);
+  expect_same(b, 1e-9);
+  EXPECT_EQ(b.homotopy.summary.refined_steps, 1);
+  ASSERT_EQ(b.active.switches.size(), 2u);
+  EXPECT_NEAR(b.active.switches[0].t, 1.0, 1e-9);
+  EXPECT_NEAR(b.active.switches[1].t, 1.1, 1e-9);
+  EXPECT_LT(b.active.x_final().lpNorm<Eigen::Infinity>(), 1e-9);
+  EXPECT_EQ(b.active.summary.active_set_path_steps, 5);
+  EXPECT_EQ(b.active.summary.homotopy_path_steps, 0);
+  EXPECT_EQ(b.active.summary.homotopy_steps, 0);
+  // 4 steps of 2 elements; the step with both switches as two halves, of which [0.9, 1.2] (both
+  // switches again) as two quarters: 2 + 2 + 2 elements
+  EXPECT_EQ(b.active.h.size(), 14u);
+}
+
+// examples/relay_feedback.toml at complementarity_tol 1e-9, sigma_N 1e-13 (where the homotopy
+// path is tight; it takes ~30 s, so its result is quoted here, not recomputed): the short slides
+// whose entry and exit lie in one step of 50 ms (steps from 5.65, 5.9, 8.65, 8.9, 9.1, 9.15) are
+// solved as half steps, every step by Newton. The homotopy path lists 22 switches; the active-set
+// path lists them too, within 3.5e-3 (this grid's accuracy: against the event list of a run with
+// N_sim = 4000, n_s = 3 the homotopy's are within 3.2e-3, the active-set path's within 5e-3), and
+// 4 more: the slides at 5.674-5.689 and 8.655-8.670 of the exact solution (34 switches), which
+// the homotopy's 4-element retry steps over (the state passes at x1 ~ 1e-4).
+TEST(ActiveSetTwoSwitches, RelayFeedbackShortSlidesByNewton) {
+  fesd::SimulationProblem q =
+      fesd::load_simulation_problem(FESD_SOURCE_DIR "/examples/relay_feedback.toml");
+  fesd::apply_override(q, "complementarity_tol", "1e-9");
+  fesd::apply_override(q, "sigma_N", "1e-13");
+  fesd::apply_override(q, "step_solver", "active_set");
+  const IntegratorResult r = fesd::integrate(q.model, q.x0, q.T_sim, q.N_sim, q.options, q.u, q.p);
+  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+  EXPECT_EQ(r.summary.active_set_path_steps, 200);
+  EXPECT_EQ(r.summary.homotopy_path_steps, 0);
+  // the homotopy path's switches (same settings, step_solver = homotopy)
+  const double homotopy[] = {
+      2.81240446485, 3.04483003986, 3.06848404466, 3.29065002129, 3.33356444961, 3.53838261926,
+      4.93288917664, 5.92023679102, 5.94523679102, 6.17094201288, 6.20521581568, 6.41928897358,
+      6.49356478046, 6.6701441746,  7.91329315769, 8.90121376151, 8.92556169107, 9.15121473312,
+      9.18556499963, 9.39999999997, 9.4735004408,  9.65000000006};
+  ASSERT_EQ(r.switches.size(), 26u);
+  for (double th : homotopy) {
+    double nearest = 1e9;
+    for (const auto& s : r.switches) nearest = std::min(nearest, std::abs(s.t - th));
+    EXPECT_LT(nearest, 3.5e-3) << "homotopy switch at " << th;
+  }
+  for (double slide : {5.674, 5.689, 8.655, 8.670}) {
+    double nearest = 1e9;
+    for (const auto& s : r.switches) nearest = std::min(nearest, std::abs(s.t - slide));
+    EXPECT_LT(nearest, 5e-3) << "short slide at " << slide;
+  }
+  // the homotopy's x(10) = (0, -0.897000402807, 2.35901724221); the event-driven one is
+  // (0, -0.89733, 2.35870): both paths are ~4e-4 from it on this grid
+  const Eigen::Vector3d x_hom(0.0, -0.897000402806606, 2.35901724221437);
+  EXPECT_LT((r.x_final() - x_hom).lpNorm<Eigen::Infinity>(), 2e-4);
+}
+
+// Gauss-Legendre (not stiffly accurate: boundary values (33) at every element end) in a sliding
+// mode: lambda_end = 0 of both regions would make the end-point LP one row too many (c(x_{n+1}) =
+// 0, implied by c = 0 at the stages); one of them stays free. Example 3(b) with the entry inside a
+// step (x0 = 0.47) and at a step boundary (x0 = 0.5), Example 3(c) with the exit inside a step
+// (N_sim = 7: Gauss-Legendre cannot pin an exit on an interior boundary, so that step runs as two
+// half steps with the exit at their common boundary t = 1) and on a step boundary (N_sim = 10).
+// Every step by Newton; switch times and x(T) exact to 1e-9 and as the homotopy path's (3(b): to
+// 1e-9; 3(c): 2e-8, the homotopy's x(2) is 7e-9 (N_sim = 7) and 1.1e-8 (10) off the exact 1/2).
+TEST(ActiveSetGaussLegendre, SlidingEntryAndExitByNewton) {
+  for (const double x0 : {0.47, 0.5}) {
+    const Both b =
+        run_file("sliding.toml", {{"x0", std::to_string(x0)}, {"rk_scheme", "gauss_legendre"}});
+    expect_same(b, 1e-9);
+    ASSERT_EQ(b.active.switches.size(), 1u);
+    EXPECT_NEAR(b.active.switches[0].t, x0, 1e-9);
+    EXPECT_NEAR(b.active.x_final()[0], 0.0, 1e-9);
+    EXPECT_EQ(b.active.summary.active_set_path_steps, 10);
+    EXPECT_EQ(b.active.summary.homotopy_path_steps, 0);
+  }
+  for (const int N_sim : {7, 10}) {
+    const Both b = run_file("leaving_sliding.toml",
+                            {{"N_sim", std::to_string(N_sim)}, {"rk_scheme", "gauss_legendre"}});
+    expect_same(b, 2e-8);
+    ASSERT_EQ(b.active.switches.size(), 1u);
+    EXPECT_NEAR(b.active.switches[0].t, 1.0, 1e-9);
+    EXPECT_NEAR(b.active.x_final()[0], 0.5, 1e-9);
+    EXPECT_EQ(b.active.summary.active_set_path_steps, N_sim);
+    EXPECT_EQ(b.active.summary.homotopy_path_steps, 0);
+  }
 }
 
 TEST(ActiveSetOptions, UnknownValueIsAClearError) {
