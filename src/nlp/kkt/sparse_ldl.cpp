@@ -74,6 +74,9 @@ constexpr double kMaxPivtol = 0.5;
 /// error |b - A x| / (|A| |x| + |b|) (max-norms) is at most kBerrTarget. The componentwise error
 /// asked for a correction in most solves on OCP (61), for rows whose |A||x| + |b| is itself
 /// round-off, without changing IPOPT's iterates (IPOPT refines on the whole system anyway).
+/// Ruiz sweeps of a factorization whose A still holds the previous factorization's scaling (same
+/// structure): started from it (three from the identity otherwise).
+constexpr int kWarmSweeps = 1;
 constexpr int kMaxRefine = 3;
 constexpr double kBerrTarget = 1e-15;
 
@@ -95,7 +98,21 @@ enum Header {
 // IKEEP[2N + 1 ..]: the symbolic analysis in IW is valid for this IW (address and length), so the
 // next factorization reuses it. IPOPT keeps IW between factorizations unless it reallocates it,
 // which changes LIW.
-enum KeepSlot { kKOrdering = 0, kKSymbolic, kKLiw, kKAddrLo, kKAddrHi, kKSlots };
+// IKEEP[2N + kKScaled ..]: A[NZ .. NZ + N) holds the previous factorization's scaling for this A
+// (address and length), the start of the next one's (kWarmSweeps).
+enum KeepSlot {
+  kKOrdering = 0,
+  kKSymbolic,
+  kKLiw,
+  kKAddrLo,
+  kKAddrHi,
+  kKSlots,
+  kKScaled = kKSlots,
+  kKLa,
+  kKAAddrLo,
+  kKAAddrHi,
+  kKScaleSlots
+};
 
 /// The structure-only part of the factorization, computed once per structure and kept in IW:
 /// arrays of ints behind these pointers.
@@ -1016,7 +1033,11 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
   // rounded to a power of two: the scaled matrix is exact, and no sqrt or division per row (they
   // were a quarter of the work outside the fronts).
   double* scale = a + nz;
-  std::fill_n(scale, n, 1.0);
+  const auto a_addr = reinterpret_cast<std::uintptr_t>(a);
+  const int a_lo = static_cast<int>(a_addr & 0x7fffffffU), a_hi = static_cast<int>(a_addr >> 31);
+  const bool warm = cached && n >= kKScaleSlots && keep[kKScaled] == 1 && keep[kKLa] == la &&
+                    keep[kKAAddrLo] == a_lo && keep[kKAAddrHi] == a_hi;
+  if (!warm) std::fill_n(scale, n, 1.0);
   Workspace& ws = thread_workspace();
   {
     std::vector<double>& rmax = ws.rmax;
@@ -1036,7 +1057,14 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
       }
       for (int i = 0; i < n; ++i) scale[i] *= inverse_sqrt_pow2(rmax[i]);
     };
-    if (all_valid) {
+    if (warm) {
+      for (int k = 0; k < kWarmSweeps; ++k) {
+        if (all_valid)
+          sweep.template operator()<false, false>();
+        else
+          sweep.template operator()<true, false>();
+      }
+    } else if (all_valid) {
       sweep.template operator()<false, true>();
       sweep.template operator()<false, false>();
       sweep.template operator()<false, false>();
@@ -1045,6 +1073,12 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
       sweep.template operator()<true, false>();
       sweep.template operator()<true, false>();
     }
+  }
+  if (n >= kKScaleSlots) {
+    keep[kKScaled] = 1;
+    keep[kKLa] = la;
+    keep[kKAAddrLo] = a_lo;
+    keep[kKAAddrHi] = a_hi;
   }
 
   // Scaled values in the permuted lower triangle.
@@ -1118,6 +1152,7 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
       const int c = own[t];
       double* fc = fr + static_cast<std::size_t>(t) * ld;
       if (nd == 0)
+#pragma GCC unroll 4
         for (int p = colptr[c]; p < colptr[c + 1]; ++p) fc[sym.amap[p]] += cval[p];
       else
         for (int p = colptr[c]; p < colptr[c + 1]; ++p) fc[shifted(sym.amap[p])] += cval[p];
@@ -1133,6 +1168,7 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
         for (int jb = 0; jb < m; ++jb) {
           const double* col = ch.block + static_cast<std::size_t>(jb) * ch.ldb;
           double* fc = fr + static_cast<std::size_t>(map[jb]) * ld;
+#pragma GCC unroll 4
           for (int ib = jb; ib < m; ++ib) fc[map[ib]] += col[ib];
         }
       } else {
@@ -1154,6 +1190,7 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
             }
           } else {
             double* fc = fr + static_cast<std::size_t>(pj) * ld;
+#pragma GCC unroll 4
             for (int ib = jb; ib < m; ++ib) fc[lp[ib]] += col[ib];
           }
         }
