@@ -463,25 +463,27 @@ FESD_KKT_INLINE double abs_max(const double* x, int from, int ld) {
   return m;
 }
 
-/// w(i) = c(i), c(i) = c(i) / d for i = from .. nf; w(i) = c(i) for i = nf .. ld (padding).
-/// Vector divisions round as scalar ones.
-FESD_KKT_INLINE void copy_and_scale(double* w, double* c, double d, int from, int nf, int ld) {
-  int i = from;
-  for (; i < nf && (i & 3) != 0; ++i) {
-    w[i] = c[i];
-    c[i] = w[i] / d;
-  }
+/// w(i) = c(i), c(i) = c(i) / d for i = from .. ld (the padding rows stay zero), in vector
+/// passes from `from` rounded down to a multiple of 4: the rows before `from` of w get c's (a
+/// front column's diagonal and unused upper triangle), c keeps them (a lane mask). Vector divisions
+/// round as scalar ones.
+FESD_KKT_INLINE void copy_and_scale(double* w, double* c, double d, int from, int ld) {
+  using Bits = long long __attribute__((vector_size(32)));
   const Vec4 dv = {d, d, d, d};
-  for (; i + 4 <= nf; i += 4) {
+  int i = from & ~3;
+  if (i < from) {
+    const Vec4 x = load4(c + i);
+    store4(w + i, x);
+    const Bits lane = {i, i + 1, i + 2, i + 3};
+    const Bits keep = lane < static_cast<long long>(from);
+    store4(c + i, keep ? x : x / dv);
+    i += 4;
+  }
+  for (; i < ld; i += 4) {
     const Vec4 x = load4(c + i);
     store4(w + i, x);
     store4(c + i, x / dv);
   }
-  for (; i < nf; ++i) {
-    w[i] = c[i];
-    c[i] = w[i] / d;
-  }
-  for (; i < ld; ++i) w[i] = c[i];
 }
 
 struct PivotResult {
@@ -556,9 +558,9 @@ FESD_KKT_KERNEL PivotResult partial_ldlt(int nf, int nfs, double* storage, int* 
       double* wk = w1.data();
       double* ck = F.col(k);
       // wk = column k below the pivot (padding rows: zero), column k = L = wk / d. Rows
-      // (k + 1) & ~3 .. k of wk keep what they held: axpy_down adds them only to the unused upper
-      // triangle.
-      copy_and_scale(wk, ck, d, k + 1, nf, ld);
+      // (k + 1) & ~3 .. k of wk get column k's diagonal and upper triangle: axpy_down adds them
+      // only to the unused upper triangle.
+      copy_and_scale(wk, ck, d, k + 1, ld);
       // Fully summed columns now; the contribution block gets one update at the end.
       for (int j = k + 1; j < nfs; ++j) axpy_down(F.col(j), wk, ck[j], j, ld);
       kind[k] = 1;
