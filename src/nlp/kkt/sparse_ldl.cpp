@@ -361,12 +361,13 @@ FESD_KKT_INLINE void store4(double* p, Vec4 v) {
 /// - 4 to the padded end (the kernels' vector loops start up to 7 rows above a diagonal). Half
 /// the stores of a memset of the whole front. Kept a loop of stores (GCC's loop distribution would
 /// make it a memset call per column).
-[[gnu::noinline, gnu::optimize("no-tree-loop-distribute-patterns")]] void zero_front(double* f,
-                                                                                     int nf) {
+FESD_KKT_KERNEL [[gnu::noinline, gnu::optimize("no-tree-loop-distribute-patterns")]] void
+zero_front(double* f, int nf) {
   const int ld = front_ld(nf);
   const Vec4 zero = {};
   for (int j = 0; j < nf; ++j) {
     double* c = f + static_cast<std::size_t>(j) * ld;
+#pragma GCC unroll 4
     for (int i = std::max(0, (j & ~3) - 4); i < ld; i += 4) store4(c + i, zero);
   }
 }
