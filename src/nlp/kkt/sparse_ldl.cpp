@@ -576,16 +576,31 @@ FESD_KKT_KERNEL PivotResult partial_ldlt(int nf, int nfs, double* storage, int* 
         res.negative += 1;
       else if (d11 + d22 < 0)
         res.negative += 2;
+      // a1, a2 = the two columns below the pivot, columns k, k + 1 = L = [a1 a2] D^-1, in vector
+      // passes from k + 2 rounded down to a multiple of 4 (padding rows included: zero); the
+      // first block keeps rows k, k + 1 (D) and the rows above of the columns (a lane mask).
       double *a1 = w1.data(), *a2 = w2.data();
-      for (int i = k + 2; i < ld; ++i) {
-        a1[i] = F.at(i, k);
-        a2[i] = F.at(i, k + 1);
-      }
       double* c1 = F.col(k);
       double* c2 = F.col(k + 1);
-      for (int i = k + 2; i < nf; ++i) {
-        c1[i] = (d22 * a1[i] - d21 * a2[i]) / det;
-        c2[i] = (d11 * a2[i] - d21 * a1[i]) / det;
+      {
+        using Bits = long long __attribute__((vector_size(32)));
+        const Vec4 v11 = {d11, d11, d11, d11}, v21 = {d21, d21, d21, d21},
+                   v22 = {d22, d22, d22, d22}, vdet = {det, det, det, det};
+        const int i0 = (k + 2) & ~3;
+        for (int i = i0; i < ld; i += 4) {
+          const Vec4 x1 = load4(c1 + i), x2 = load4(c2 + i);
+          store4(a1 + i, x1);
+          store4(a2 + i, x2);
+          Vec4 l1 = (v22 * x1 - v21 * x2) / vdet, l2 = (v11 * x2 - v21 * x1) / vdet;
+          if (i == i0) {
+            const Bits lane = {i, i + 1, i + 2, i + 3};
+            const Bits keep = lane < static_cast<long long>(k + 2);
+            l1 = keep ? x1 : l1;
+            l2 = keep ? x2 : l2;
+          }
+          store4(c1 + i, l1);
+          store4(c2 + i, l2);
+        }
       }
       for (int j = k + 2; j < nfs; ++j) {
         // Rows from j rounded down: the upper triangle of column j (c1, c2 hold D and the
