@@ -74,6 +74,9 @@ constexpr double kMaxPivtol = 0.5;
 /// error |b - A x| / (|A| |x| + |b|) (max-norms) is at most kBerrTarget. The componentwise error
 /// asked for a correction in most solves on OCP (61), for rows whose |A||x| + |b| is itself
 /// round-off, without changing IPOPT's iterates (IPOPT refines on the whole system anyway).
+/// Ruiz sweeps of a factorization whose A still holds the previous factorization's scaling (same
+/// structure): started from it (three from the identity otherwise).
+constexpr int kWarmSweeps = 1;
 constexpr int kMaxRefine = 3;
 constexpr double kBerrTarget = 1e-15;
 
@@ -95,7 +98,21 @@ enum Header {
 // IKEEP[2N + 1 ..]: the symbolic analysis in IW is valid for this IW (address and length), so the
 // next factorization reuses it. IPOPT keeps IW between factorizations unless it reallocates it,
 // which changes LIW.
-enum KeepSlot { kKOrdering = 0, kKSymbolic, kKLiw, kKAddrLo, kKAddrHi, kKSlots };
+// IKEEP[2N + kKScaled ..]: A[NZ .. NZ + N) holds the previous factorization's scaling for this A
+// (address and length), the start of the next one's (kWarmSweeps).
+enum KeepSlot {
+  kKOrdering = 0,
+  kKSymbolic,
+  kKLiw,
+  kKAddrLo,
+  kKAddrHi,
+  kKSlots,
+  kKScaled = kKSlots,
+  kKLa,
+  kKAAddrLo,
+  kKAAddrHi,
+  kKScaleSlots
+};
 
 /// The structure-only part of the factorization, computed once per structure and kept in IW:
 /// arrays of ints behind these pointers.
@@ -344,12 +361,13 @@ FESD_KKT_INLINE void store4(double* p, Vec4 v) {
 /// - 4 to the padded end (the kernels' vector loops start up to 7 rows above a diagonal). Half
 /// the stores of a memset of the whole front. Kept a loop of stores (GCC's loop distribution would
 /// make it a memset call per column).
-[[gnu::noinline, gnu::optimize("no-tree-loop-distribute-patterns")]] void zero_front(double* f,
-                                                                                     int nf) {
+FESD_KKT_KERNEL [[gnu::noinline, gnu::optimize("no-tree-loop-distribute-patterns")]] void
+zero_front(double* f, int nf) {
   const int ld = front_ld(nf);
   const Vec4 zero = {};
   for (int j = 0; j < nf; ++j) {
     double* c = f + static_cast<std::size_t>(j) * ld;
+#pragma GCC unroll 4
     for (int i = std::max(0, (j & ~3) - 4); i < ld; i += 4) store4(c + i, zero);
   }
 }
@@ -446,25 +464,27 @@ FESD_KKT_INLINE double abs_max(const double* x, int from, int ld) {
   return m;
 }
 
-/// w(i) = c(i), c(i) = c(i) / d for i = from .. nf; w(i) = c(i) for i = nf .. ld (padding).
-/// Vector divisions round as scalar ones.
-FESD_KKT_INLINE void copy_and_scale(double* w, double* c, double d, int from, int nf, int ld) {
-  int i = from;
-  for (; i < nf && (i & 3) != 0; ++i) {
-    w[i] = c[i];
-    c[i] = w[i] / d;
-  }
+/// w(i) = c(i), c(i) = c(i) / d for i = from .. ld (the padding rows stay zero), in vector
+/// passes from `from` rounded down to a multiple of 4: the rows before `from` of w get c's (a
+/// front column's diagonal and unused upper triangle), c keeps them (a lane mask). Vector divisions
+/// round as scalar ones.
+FESD_KKT_INLINE void copy_and_scale(double* w, double* c, double d, int from, int ld) {
+  using Bits = long long __attribute__((vector_size(32)));
   const Vec4 dv = {d, d, d, d};
-  for (; i + 4 <= nf; i += 4) {
+  int i = from & ~3;
+  if (i < from) {
+    const Vec4 x = load4(c + i);
+    store4(w + i, x);
+    const Bits lane = {i, i + 1, i + 2, i + 3};
+    const Bits keep = lane < static_cast<long long>(from);
+    store4(c + i, keep ? x : x / dv);
+    i += 4;
+  }
+  for (; i < ld; i += 4) {
     const Vec4 x = load4(c + i);
     store4(w + i, x);
     store4(c + i, x / dv);
   }
-  for (; i < nf; ++i) {
-    w[i] = c[i];
-    c[i] = w[i] / d;
-  }
-  for (; i < ld; ++i) w[i] = c[i];
 }
 
 struct PivotResult {
@@ -539,9 +559,9 @@ FESD_KKT_KERNEL PivotResult partial_ldlt(int nf, int nfs, double* storage, int* 
       double* wk = w1.data();
       double* ck = F.col(k);
       // wk = column k below the pivot (padding rows: zero), column k = L = wk / d. Rows
-      // (k + 1) & ~3 .. k of wk keep what they held: axpy_down adds them only to the unused upper
-      // triangle.
-      copy_and_scale(wk, ck, d, k + 1, nf, ld);
+      // (k + 1) & ~3 .. k of wk get column k's diagonal and upper triangle: axpy_down adds them
+      // only to the unused upper triangle.
+      copy_and_scale(wk, ck, d, k + 1, ld);
       // Fully summed columns now; the contribution block gets one update at the end.
       for (int j = k + 1; j < nfs; ++j) axpy_down(F.col(j), wk, ck[j], j, ld);
       kind[k] = 1;
@@ -556,16 +576,31 @@ FESD_KKT_KERNEL PivotResult partial_ldlt(int nf, int nfs, double* storage, int* 
         res.negative += 1;
       else if (d11 + d22 < 0)
         res.negative += 2;
+      // a1, a2 = the two columns below the pivot, columns k, k + 1 = L = [a1 a2] D^-1, in vector
+      // passes from k + 2 rounded down to a multiple of 4 (padding rows included: zero); the
+      // first block keeps rows k, k + 1 (D) and the rows above of the columns (a lane mask).
       double *a1 = w1.data(), *a2 = w2.data();
-      for (int i = k + 2; i < ld; ++i) {
-        a1[i] = F.at(i, k);
-        a2[i] = F.at(i, k + 1);
-      }
       double* c1 = F.col(k);
       double* c2 = F.col(k + 1);
-      for (int i = k + 2; i < nf; ++i) {
-        c1[i] = (d22 * a1[i] - d21 * a2[i]) / det;
-        c2[i] = (d11 * a2[i] - d21 * a1[i]) / det;
+      {
+        using Bits = long long __attribute__((vector_size(32)));
+        const Vec4 v11 = {d11, d11, d11, d11}, v21 = {d21, d21, d21, d21},
+                   v22 = {d22, d22, d22, d22}, vdet = {det, det, det, det};
+        const int i0 = (k + 2) & ~3;
+        for (int i = i0; i < ld; i += 4) {
+          const Vec4 x1 = load4(c1 + i), x2 = load4(c2 + i);
+          store4(a1 + i, x1);
+          store4(a2 + i, x2);
+          Vec4 l1 = (v22 * x1 - v21 * x2) / vdet, l2 = (v11 * x2 - v21 * x1) / vdet;
+          if (i == i0) {
+            const Bits lane = {i, i + 1, i + 2, i + 3};
+            const Bits keep = lane < static_cast<long long>(k + 2);
+            l1 = keep ? x1 : l1;
+            l2 = keep ? x2 : l2;
+          }
+          store4(c1 + i, l1);
+          store4(c2 + i, l2);
+        }
       }
       for (int j = k + 2; j < nfs; ++j) {
         // Rows from j rounded down: the upper triangle of column j (c1, c2 hold D and the
@@ -1016,7 +1051,11 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
   // rounded to a power of two: the scaled matrix is exact, and no sqrt or division per row (they
   // were a quarter of the work outside the fronts).
   double* scale = a + nz;
-  std::fill_n(scale, n, 1.0);
+  const auto a_addr = reinterpret_cast<std::uintptr_t>(a);
+  const int a_lo = static_cast<int>(a_addr & 0x7fffffffU), a_hi = static_cast<int>(a_addr >> 31);
+  const bool warm = cached && n >= kKScaleSlots && keep[kKScaled] == 1 && keep[kKLa] == la &&
+                    keep[kKAAddrLo] == a_lo && keep[kKAAddrHi] == a_hi;
+  if (!warm) std::fill_n(scale, n, 1.0);
   Workspace& ws = thread_workspace();
   {
     std::vector<double>& rmax = ws.rmax;
@@ -1036,7 +1075,14 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
       }
       for (int i = 0; i < n; ++i) scale[i] *= inverse_sqrt_pow2(rmax[i]);
     };
-    if (all_valid) {
+    if (warm) {
+      for (int k = 0; k < kWarmSweeps; ++k) {
+        if (all_valid)
+          sweep.template operator()<false, false>();
+        else
+          sweep.template operator()<true, false>();
+      }
+    } else if (all_valid) {
       sweep.template operator()<false, true>();
       sweep.template operator()<false, false>();
       sweep.template operator()<false, false>();
@@ -1045,6 +1091,12 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
       sweep.template operator()<true, false>();
       sweep.template operator()<true, false>();
     }
+  }
+  if (n >= kKScaleSlots) {
+    keep[kKScaled] = 1;
+    keep[kKLa] = la;
+    keep[kKAAddrLo] = a_lo;
+    keep[kKAAddrHi] = a_hi;
   }
 
   // Scaled values in the permuted lower triangle.
@@ -1118,6 +1170,7 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
       const int c = own[t];
       double* fc = fr + static_cast<std::size_t>(t) * ld;
       if (nd == 0)
+#pragma GCC unroll 4
         for (int p = colptr[c]; p < colptr[c + 1]; ++p) fc[sym.amap[p]] += cval[p];
       else
         for (int p = colptr[c]; p < colptr[c + 1]; ++p) fc[shifted(sym.amap[p])] += cval[p];
@@ -1133,6 +1186,7 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
         for (int jb = 0; jb < m; ++jb) {
           const double* col = ch.block + static_cast<std::size_t>(jb) * ch.ldb;
           double* fc = fr + static_cast<std::size_t>(map[jb]) * ld;
+#pragma GCC unroll 4
           for (int ib = jb; ib < m; ++ib) fc[map[ib]] += col[ib];
         }
       } else {
@@ -1154,6 +1208,7 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
             }
           } else {
             double* fc = fr + static_cast<std::size_t>(pj) * ld;
+#pragma GCC unroll 4
             for (int ib = jb; ib < m; ++ib) fc[lp[ib]] += col[ib];
           }
         }
