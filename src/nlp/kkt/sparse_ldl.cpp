@@ -75,7 +75,12 @@ constexpr double kMaxPivtol = 0.5;
 /// asked for a correction in most solves on OCP (61), for rows whose |A||x| + |b| is itself
 /// round-off, without changing IPOPT's iterates (IPOPT refines on the whole system anyway).
 /// Ruiz sweeps of a factorization whose A still holds the previous factorization's scaling (same
-/// structure): started from it (three from the identity otherwise).
+/// structure): started from it (three from the identity otherwise). Off (kReuseScaling): with it,
+/// the changed round-off made IPOPT's pinned re-solve fail in the homotopy path's co-dimension-2
+/// exit of the periodic stick-slip (PeriodicStickSlipExit.BothContactsSlipWhenX1ReachesOne, in
+/// the sanitizer build's code generation), for about 0.3 M of 4.7 M instructions per
+/// factorization on the nosnoc run.
+constexpr bool kReuseScaling = false;
 constexpr int kWarmSweeps = 1;
 constexpr int kMaxRefine = 3;
 constexpr double kBerrTarget = 1e-15;
@@ -1053,8 +1058,8 @@ void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int
   double* scale = a + nz;
   const auto a_addr = reinterpret_cast<std::uintptr_t>(a);
   const int a_lo = static_cast<int>(a_addr & 0x7fffffffU), a_hi = static_cast<int>(a_addr >> 31);
-  const bool warm = cached && n >= kKScaleSlots && keep[kKScaled] == 1 && keep[kKLa] == la &&
-                    keep[kKAAddrLo] == a_lo && keep[kKAAddrHi] == a_hi;
+  const bool warm = kReuseScaling && cached && n >= kKScaleSlots && keep[kKScaled] == 1 &&
+                    keep[kKLa] == la && keep[kKAAddrLo] == a_lo && keep[kKAAddrHi] == a_hi;
   if (!warm) std::fill_n(scale, n, 1.0);
   Workspace& ws = thread_workspace();
   {
