@@ -196,16 +196,13 @@ TEST_P(ActiveSetSlidingExit, ByNewtonSameAsHomotopy) {
 }
 INSTANTIATE_TEST_SUITE_P(NSim, ActiveSetSlidingExit, ::testing::Values(7, 10));
 
-// Co-dimension 2 in a Cartesian product (docs/problem-files.md): x1' in -sign(x1), x2' in
-// -sign(x2) from (1, -2): x1 reaches 0 at t = 1 and slides (subsystem 0: {0} -> {0, 1}), x2 at
-// t = 2 (subsystem 1: {3} -> {2, 3}), then both stay at 0. Each subsystem's theta is determined
-// by its own surface: the square system is regular. N_sim = 7 on [0, 3] puts both entries inside
-// steps. No NLP; exact to 1e-9 and as the homotopy path.
-TEST(ActiveSetSliding, CodimensionTwoInACartesianProduct) {
+// x1' in -sign(x1), x2' in -sign(x2) from (1, x2_0) on [0, 3] as a problem file of two
+// subsystems (Radau IIA n_s = 2, N_FE = 2), with N_sim steps.
+fesd::SimulationProblem cartesian_product(const std::string& x2_0, const std::string& N_sim) {
   const std::string text = R"(
 [model]
 x = ["x1", "x2"]
-x0 = [1, -2]
+x0 = [1, )" + x2_0 + R"(]
 [[model.subsystem]]
 c = ["x1"]
 F = [["-1", "0"], ["1", "0"]]
@@ -214,13 +211,22 @@ g = ["-x2", "x2"]
 F = [["0", "-1"], ["0", "1"]]
 [simulation]
 T_sim = 3.0
-N_sim = 7
+N_sim = )" + N_sim + R"(
 [discretization]
 rk_scheme = "radau_iia"
 n_s = 2
 N_finite_elements = 2
 )";
-  fesd::SimulationProblem q = fesd::parse_simulation_problem(text, "product.toml");
+  return fesd::parse_simulation_problem(text, "product.toml");
+}
+
+// Co-dimension 2 in a Cartesian product (docs/problem-files.md): x1' in -sign(x1), x2' in
+// -sign(x2) from (1, -2): x1 reaches 0 at t = 1 and slides (subsystem 0: {0} -> {0, 1}), x2 at
+// t = 2 (subsystem 1: {3} -> {2, 3}), then both stay at 0. Each subsystem's theta is determined
+// by its own surface: the square system is regular. N_sim = 7 on [0, 3] puts both entries inside
+// steps. No NLP; exact to 1e-9 and as the homotopy path.
+TEST(ActiveSetSliding, CodimensionTwoInACartesianProduct) {
+  const fesd::SimulationProblem q = cartesian_product("-2", "7");
   const Both b = run_both(q.model, q.x0, q.T_sim, q.N_sim, q.options);
   expect_same(b, 1e-9);
   ASSERT_EQ(b.active.switches.size(), 2u);
@@ -289,25 +295,7 @@ TEST(ActiveSetSliding, StickSlipCodimensionTwoEvents) {
 // [0.9, 1.2], has both switches too and runs as two quarter steps (entries at 1 and 1.1). Same
 // switches and x(T) to 1e-9, exact; every step by Newton.
 TEST(ActiveSetTwoSwitches, CartesianProductEntriesInOneStep) {
-  const std::string text = R"(
-[model]
-x = ["x1", "x2"]
-x0 = [1, -1.1]
-[[model.subsystem]]
-c = ["x1"]
-F = [["-1", "0"], ["1", "0"]]
-[[model.subsystem]]
-g = ["-x2", "x2"]
-F = [["0", "-1"], ["0", "1"]]
-[simulation]
-T_sim = 3.0
-N_sim = 5
-[discretization]
-rk_scheme = "radau_iia"
-n_s = 2
-N_finite_elements = 2
-)";
-  fesd::SimulationProblem q = fesd::parse_simulation_problem(text, "product.toml");
+  const fesd::SimulationProblem q = cartesian_product("-1.1", "5");
   const Both b = run_both(q.model, q.x0, q.T_sim, q.N_sim, q.options);
   expect_same(b, 1e-9);
   EXPECT_EQ(b.homotopy.summary.refined_steps, 1);
