@@ -255,14 +255,10 @@ class Integrator {
       const discretization::FesdInterval& iv = as.interval();
       const std::vector<double>& w = as.solution();
       pieces_.push_back({k, w});
-      const int last = iv.N_FE() - 1, n_s = d_.n_s;
-      const int n_x = model_.n_x(), n_th = model_.n_theta(), n_sys = model_.n_sys();
-      for (int i = 0; i < n_x; ++i) start.x[i] = w[iv.x(last + 1, i)];
+      const int last = iv.N_FE() - 1;
+      for (int i = 0; i < model_.n_x(); ++i) start.x[i] = w[iv.x(last + 1, i)];
       start.predicted = iv.active_set(w.data(), last);
-      start.lp.theta = gather(w, iv.theta(last, n_s - 1, 0), n_th);
-      start.lp.lambda = gather(w, iv.lambda(last, n_s - 1, 0), n_th);
-      start.lp.mu = gather(w, iv.mu(last, n_s - 1, 0), n_sys);
-      start.xdot = gather(w, iv.V(last, n_s - 1, 0), n_x);
+      last_stage_guess(iv, w, start.lp, start.xdot);
       return true;
     }
     if (k == kMaxActiveSplit) return false;
@@ -407,14 +403,16 @@ class Integrator {
            mode != MpccMode::FischerBurmeister;
   }
 
-  /// The bounds of the re-solve with the active sets of the current solution fixed and `pins`
-  /// (the exits inside the step, FesdInterval::exits_to_pin, when pin_sliding_exits) pinned; one
-  /// exit at the step start is added to `pins` where the step before ended with the leaving
-  /// region still active (step_start_exits).
+  /// The bounds of the re-solve with the active sets of the current solution fixed and its
+  /// sliding exits pinned (when pin_sliding_exits), which are returned in `pins`: the exits
+  /// inside the step (FesdInterval::exits_to_pin) and one at the step start where the step
+  /// before ended with the leaving region still active (step_start_exits).
   std::vector<nlp::Bound> fixed_set_bounds(
       StepProblem& sp, std::vector<discretization::FesdInterval::ExitPin>& pins) {
     const discretization::FesdInterval& iv = *sp.iv;
     const std::vector<double>& w = sp.mpcc.solution();
+    pins.clear();
+    if (d_.pin_sliding_exits) pins = iv.exits_to_pin(w.data(), /*control_jump_at_end=*/false);
     const double h0_min = d_.pin_sliding_exits ? step_start_exits(iv, w, pins) : 0.0;
     std::vector<nlp::Bound> bounds = iv.pin_bounds(w.data(), pins);
     const int h0 = iv.h(0);
@@ -438,7 +436,6 @@ class Integrator {
   std::vector<int> resolve_fixed(StepProblem& sp, mpcc::HomotopyResult& hr,
                                  std::vector<HomotopyRow>& rows) {
     std::vector<discretization::FesdInterval::ExitPin> pins;
-    if (d_.pin_sliding_exits) pins = sp.iv->exits_to_pin(sp.mpcc.solution().data(), false);
     const std::vector<nlp::Bound> bounds = fixed_set_bounds(sp, pins);
     if (pins.empty() && !options_.homotopy.fix_active_set) return {};
     const int n_pins = static_cast<int>(pins.size());
@@ -610,7 +607,6 @@ class Integrator {
       if (!stable || now == before->second || !(sigma <= hopt.active_set_sigma) || slides(now))
         return false;
       std::vector<discretization::FesdInterval::ExitPin> pins;
-      if (d_.pin_sliding_exits) pins = sp.iv->exits_to_pin(sp.mpcc.solution().data(), false);
       const std::vector<nlp::Bound> bounds = fixed_set_bounds(sp, pins);
       const int n_pins = static_cast<int>(pins.size());
       const nlp::Iterate relaxed = sp.mpcc.iterate();
@@ -662,12 +658,19 @@ class Integrator {
   void accept(const discretization::FesdInterval& iv, const std::vector<double>& w) {
     append_step(res_, model_, iv, tab_, w, t_);
     x_ = res_.x.back();
+    last_stage_guess(iv, w, guess_, guess_xdot_);
+  }
+
+  /// theta, lambda, mu and x' at the last stage of the interval's solution w: the guess of the
+  /// step (or piece of a step) that starts where it ends.
+  void last_stage_guess(const discretization::FesdInterval& iv, const std::vector<double>& w,
+                        dcs::LpSolution& lp, Eigen::VectorXd& xdot) const {
     const int last = iv.N_FE() - 1, n_s = d_.n_s;
     const int n_x = model_.n_x(), n_th = model_.n_theta(), n_sys = model_.n_sys();
-    guess_.theta = gather(w, iv.theta(last, n_s - 1, 0), n_th);
-    guess_.lambda = gather(w, iv.lambda(last, n_s - 1, 0), n_th);
-    guess_.mu = gather(w, iv.mu(last, n_s - 1, 0), n_sys);
-    guess_xdot_ = gather(w, iv.V(last, n_s - 1, 0), n_x);
+    lp.theta = gather(w, iv.theta(last, n_s - 1, 0), n_th);
+    lp.lambda = gather(w, iv.lambda(last, n_s - 1, 0), n_th);
+    lp.mu = gather(w, iv.mu(last, n_s - 1, 0), n_sys);
+    xdot = gather(w, iv.V(last, n_s - 1, 0), n_x);
   }
 
   /// Ends the run at a failed step; the failed attempt's last iterate is reported too, so that
