@@ -9,6 +9,8 @@
 
 #include <fmt/format.h>
 
+#include "fesd/options.hpp"
+
 namespace fesd_bench {
 
 /// Prints "<program>: <why>" and the program's usage to stderr, then exits with exit_code.
@@ -60,6 +62,13 @@ inline std::vector<int> parse_list(const std::string& flag, const std::string& v
   for (const std::string& item : split(v, ',')) out.push_back(parse_int(flag, item));
   if (out.empty()) usage(flag + ": empty list");
   return out;
+}
+
+/// `--step-solver active_set|homotopy`, or usage() naming the flag.
+inline fesd::StepSolver parse_step_solver(const std::string& flag, const std::string& v) {
+  fesd::StepSolver s{};
+  if (!fesd::parse(v, s)) usage(fmt::format("{} {}: expected active_set or homotopy", flag, v));
+  return s;
 }
 
 }  // namespace fesd_bench

@@ -177,6 +177,7 @@ struct Config {
   bool run_std = true, run_fesd = true;
   double comp_tol = 1e-12, sigma_N = 1e-13, ipopt_tol = 1e-12;
   fesd::StageLambdaSign stage_sign = fesd::StageLambdaSign::Auto;
+  fesd::StepSolver step_solver = fesd::IntegratorOptions{}.step_solver;  // the library's default
   std::string csv, json;
   bool quick = false;
 };
@@ -215,6 +216,8 @@ Config parse_args(int argc, char** argv) {
         usage("--stage-sign " + v + ": expected all, boundary or auto");
     } else if (a == "--comp-tol") {
       cfg.comp_tol = parse_double(a, value());
+    } else if (a == "--step-solver") {
+      cfg.step_solver = fesd_bench::parse_step_solver(a, value());
     } else if (a == "--sigma-N") {
       cfg.sigma_N = parse_double(a, value());
     } else if (a == "--ipopt-tol") {
@@ -280,6 +283,7 @@ Run run_one(const Method& m, bool use_fesd, int N_sim, const Config& cfg) {
   opt.discretization.stage_lambda_sign = cfg.stage_sign;
   opt.homotopy.complementarity_tol = cfg.comp_tol;
   opt.homotopy.sigma_N = cfg.sigma_N;
+  opt.step_solver = cfg.step_solver;
   opt.nlp.tol = cfg.ipopt_tol;
   Run r;
   r.method = &m;
@@ -324,7 +328,8 @@ void fesd_bench::usage(const std::string& why, int exit_code) {
       "usage: fig8_accuracy [--quick] [--methods scheme[:n_s],...] [--N n1,...] [--N-low n1,...]\n"
       "                     [--mode both|fesd|std] [--comp-tol X] [--sigma-N X]\n"
       "                     [--stage-sign auto|all|boundary]\n"
-      "                     [--ipopt-tol X] [--csv FILE] [--json FILE]\n"
+      "                     [--ipopt-tol X] [--step-solver active_set|homotopy]\n"
+      "                     [--csv FILE] [--json FILE]\n"
       "schemes: radau_iia gauss_legendre lobatto_iiia lobatto_iiic explicit_rk\n",
       why.c_str());
   std::exit(exit_code);
@@ -368,8 +373,8 @@ int main(int argc, char** argv) {
   }
 
   fmt::print("Fig. 8: nonsmooth oscillator (47), T = pi/2, N_FE = 2, h = T/N_sim\n");
-  fmt::print("IPOPT tol {:.0e}, complementarity_tol {:.0e}, sigma_N {:.0e}\n", cfg.ipopt_tol,
-             cfg.comp_tol, cfg.sigma_N);
+  fmt::print("IPOPT tol {:.0e}, complementarity_tol {:.0e}, sigma_N {:.0e}; FESD step_solver {}\n",
+             cfg.ipopt_tol, cfg.comp_tol, cfg.sigma_N, fesd::to_string(cfg.step_solver));
   fmt::print(
       "FAIL = status not success; '-' = no switch detected; '*' = more than one switch detected\n");
 

@@ -91,6 +91,7 @@ struct Config {
   std::vector<int> stages{2, 3, 4};
   std::vector<int> N{10, 20, 40, 80};
   double comp_tol = 1e-12, sigma_N = 1e-12;
+  fesd::StepSolver step_solver = fesd::IntegratorOptions{}.step_solver;  // the library's default
   std::string csv, json;
 };
 
@@ -117,6 +118,8 @@ Config parse_args(int argc, char** argv) {
       c.N = parse_list(a, value());
     } else if (a == "--comp-tol") {
       c.comp_tol = parse_double(a, value());
+    } else if (a == "--step-solver") {
+      c.step_solver = fesd_bench::parse_step_solver(a, value());
     } else if (a == "--sigma-N") {
       c.sigma_N = parse_double(a, value());
     } else if (a == "--csv") {
@@ -140,6 +143,7 @@ Measurement measure(int n_s, int N_sim, int rep, const Config& cfg) {
   opt.discretization.use_fesd = true;
   opt.homotopy.complementarity_tol = cfg.comp_tol;
   opt.homotopy.sigma_N = cfg.sigma_N;
+  opt.step_solver = cfg.step_solver;
   opt.nlp.tol = 1e-12;
   static const fesd::Pss model = fesd_bench::oscillator_model();
   Measurement m;
@@ -203,6 +207,7 @@ void fesd_bench::usage(const std::string& why, int exit_code) {
       "oscillator_timing: %s\n"
       "usage: oscillator_timing [--part a|b|both] [--repeat R] [--N-a N] [--stages 2,3,4]\n"
       "                         [--N 10,20,40,80] [--comp-tol X] [--sigma-N X]\n"
+      "                         [--step-solver active_set|homotopy]\n"
       "                         [--csv FILE] [--json FILE]\n",
       why.c_str());
   std::exit(exit_code);
@@ -219,8 +224,8 @@ int main(int argc, char** argv) {
                      {"sigma_N", cfg.sigma_N}};
   fmt::print(
       "Oscillator (47), FESD, Radau IIA, N_FE = 2, T = pi/2; IPOPT tol 1e-12, "
-      "complementarity_tol {:.0e}, sigma_N {:.0e}\n",
-      cfg.comp_tol, cfg.sigma_N);
+      "complementarity_tol {:.0e}, sigma_N {:.0e}; step_solver {}\n",
+      cfg.comp_tol, cfg.sigma_N, fesd::to_string(cfg.step_solver));
 
   // ---- (a) where the time goes ----
   if (cfg.part_a) {

@@ -178,14 +178,16 @@ struct NlpOptions {
 /// How the integrator solves the FESD equations of each step (docs/active-set.md).
 enum class StepSolver {
   /// The MPCC homotopy of relaxed NLPs solved by IPOPT (10-13 NLPs per step), with the retry
-  /// policy (tight, sparse, refined, split) and the re-solve with the active set fixed (default).
+  /// policy (tight, sparse, refined, split) and the re-solve with the active set fixed. Every
+  /// step of the standard method (use_fesd = false) runs on this path.
   Homotopy,
   /// Thm 15: with the active set of every finite element fixed, the FESD equations of a step are
   /// a square nonlinear system, solved by Newton's method with the exact Jacobian (no IPOPT).
   /// The active set is predicted from the previous step's end; where the complementarity signs
   /// fail, a switch (crossing) is placed on an element boundary whose length becomes free. A
   /// step where no consistent active set is found in a few tries falls back to the homotopy
-  /// (Summary::active_set_path_steps, homotopy_path_steps). Needs FESD (use_fesd = true).
+  /// (Summary::active_set_path_steps, homotopy_path_steps). The default; applies to FESD
+  /// (use_fesd = true): the standard method has no free lengths and uses the homotopy.
   ActiveSet,
 };
 /// Problem-file key `step_solver` ([simulation]): "homotopy", "active_set".
@@ -199,7 +201,7 @@ struct IntegratorOptions {
   NlpOptions nlp;
   /// `step_solver` ([simulation]): the homotopy of IPOPT solves, or Newton's method on the square
   /// system of the predicted active set with the homotopy as fallback (StepSolver).
-  StepSolver step_solver = StepSolver::Homotopy;
+  StepSolver step_solver = StepSolver::ActiveSet;
   /// Called after every integration step (the CLI prints format_step_progress() of it); the
   /// library itself never prints.
   StepCallback on_step;

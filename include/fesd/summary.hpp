@@ -134,6 +134,10 @@ struct StepProgress {
   double comp_residual = 0;
   Status status = Status::NotRun;  ///< of the step's last attempt
   int run = 0;  ///< simulate(): which of its runs (1-based); 0: a plain integrate()
+  /// The step was solved on the active-set path (Newton, no NLP; nlps, nlp_iterations and
+  /// comp_residual are 0), with newton_iterations iterations over its square systems.
+  bool active_set_path = false;
+  int newton_iterations = 0;
 };
 using StepCallback = std::function<void(const StepProgress&)>;
 /// Progress of a homotopy: one call per NLP solved (the OCP; re-solves included).

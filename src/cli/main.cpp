@@ -427,6 +427,15 @@ void print_header(const fesd::SimulationProblem& problem) {
   out::print("  simulation  T_sim = {:g}, {}; fix_active_set = {}\n", problem.T_sim,
              fesd::format_accuracy_rule(accuracy, problem.T_sim),
              yes_no(o.homotopy.fix_active_set));
+  if (!o.discretization.use_fesd)
+    out::print(
+        "  step solver homotopy (the standard method has no free lengths: every step by IPOPT)\n");
+  else if (o.step_solver == fesd::StepSolver::ActiveSet)
+    out::print(
+        "  step solver active_set (Newton on the square system of Thm 15; the homotopy only "
+        "where no consistent active set is found)\n");
+  else
+    out::print("  step solver homotopy (every step an MPCC homotopy of IPOPT solves)\n");
   flush_stdout();
 }
 

@@ -154,13 +154,6 @@ std::string no_estimate_needs_N_sim(const T& t, double error_estimate) {
 }
 
 /// Thm 15's square system has the element lengths as unknowns: FESD only.
-std::string active_set_needs_fesd(const T& t, double solver) {
-  if (static_cast<StepSolver>(static_cast<int>(solver)) != StepSolver::ActiveSet ||
-      t.discretization == nullptr || t.discretization->use_fesd)
-    return {};
-  return "needs use_fesd = true (the standard method has no switch detection; use homotopy)";
-}
-
 std::string ell_1_needs_terminal_constraints(const T& t, double mode) {
   if (static_cast<TerminalConstraint>(static_cast<int>(mode)) != TerminalConstraint::L1 ||
       t.ocp->n_g_terminal > 0)
@@ -202,10 +195,11 @@ std::vector<Option> build() {
            kSim, "error_estimate", Use::Simulation,
            "with N_sim given, estimate the error from two companion runs (false: one run)", ""),
        [](Option& x) { x.rule = no_estimate_needs_N_sim; });
-  with(scalar<&T::step_solver>(
-           kSim, "step_solver", Use::Simulation,
-           "per step: the MPCC homotopy (IPOPT), or Newton on the active set's square system", ""),
-       [](Option& x) { x.rule = active_set_needs_fesd; });
+  o.push_back(scalar<&T::step_solver>(
+      kSim, "step_solver", Use::Simulation,
+      "per step: Newton on the active set's square system (homotopy fallback), or the MPCC "
+      "homotopy (IPOPT); the standard method (use_fesd = false) always uses the homotopy",
+      ""));
   o.push_back(input(kSim, "u", Use::Simulation,
                     "constant control values, one per control (comma-separated)", "", true));
   o.push_back(input(kSim, "t0", Use::Simulation,

@@ -34,9 +34,14 @@ std::string format_homotopy_row(const HomotopyRow& r) {
 }
 
 std::string format_step_progress(const StepProgress& p) {
-  return fmt::format("{}  step {:>4}/{}  t = {:<10.6g}  NLPs {:>2}  iter {:>4}  comp {:.1e}  {}\n",
-                     p.run > 0 ? fmt::format("  run {}", p.run) : "", p.step, p.N_sim, p.t, p.nlps,
-                     p.nlp_iterations, p.comp_residual, to_string(p.status));
+  const std::string head =
+      fmt::format("{}  step {:>4}/{}  t = {:<10.6g}  ",
+                  p.run > 0 ? fmt::format("  run {}", p.run) : "", p.step, p.N_sim, p.t);
+  if (p.active_set_path)
+    return head + fmt::format("Newton {:>3}  (active set)       {}\n", p.newton_iterations,
+                              to_string(p.status));
+  return head + fmt::format("NLPs {:>2}  iter {:>4}  comp {:.1e}  {}\n", p.nlps, p.nlp_iterations,
+                            p.comp_residual, to_string(p.status));
 }
 
 std::string format_warnings(const Summary& s) {
@@ -50,16 +55,20 @@ std::string format_work(const Summary& s, double per_step) {
   auto per = [&](double v, const char* unit) {
     return per_step > 0 ? fmt::format("  ({:.1f} per {})", v / per_step, unit) : std::string();
   };
-  out +=
-      fmt::format("  NLPs solved          {}{}\n", s.homotopy_steps, per(s.homotopy_steps, "step"));
-  out +=
-      fmt::format("  IPOPT iterations     {}{}\n", s.nlp_iterations, per(s.nlp_iterations, "step"));
-  out += fmt::format("  max comp. residual   {:.2e}\n", s.max_comp_residual);
   if (s.active_set_path_steps > 0)
     out += fmt::format(
         "  active-set steps     {}  ({} by the homotopy; {} Newton iterations{}, {:.3f} s)\n",
         s.active_set_path_steps, s.homotopy_path_steps, s.newton_iterations,
         per(s.newton_iterations, "step"), s.active_set_s);
+  // Every step by Newton: no NLP, nothing to say about IPOPT.
+  const bool nlps = s.homotopy_steps > 0 || s.active_set_path_steps == 0;
+  if (nlps) {
+    out += fmt::format("  NLPs solved          {}{}\n", s.homotopy_steps,
+                       per(s.homotopy_steps, "step"));
+    out += fmt::format("  IPOPT iterations     {}{}\n", s.nlp_iterations,
+                       per(s.nlp_iterations, "step"));
+    out += fmt::format("  max comp. residual   {:.2e}\n", s.max_comp_residual);
+  }
   if (s.fallback_steps > 0)
     out += fmt::format("  retried steps        {}  (sparse cross complementarity (28))\n",
                        s.fallback_steps);
@@ -91,6 +100,7 @@ std::string format_work(const Summary& s, double per_step) {
                        s.born_switches);
   out += fmt::format("  wall time            {:.3f} s", s.wall_s);
   out += per_step > 0 ? fmt::format("  ({:.2f} ms per step)\n", 1e3 * s.wall_s / per_step) : "\n";
+  if (!nlps) return out;
   const double busy = s.derivative_s + s.solver_s;
   out += fmt::format("    derivatives        {:.3f} s  ({:.0f} %)\n", s.derivative_s,
                      busy > 0 ? 100 * s.derivative_s / busy : 0.0);

@@ -138,7 +138,9 @@ class Integrator {
     // Initial guess of the first step: the LP at x0 (then the last stage of the step before).
     guess_ = dcs::solve_lp(model_, x0, p_);
     guess_xdot_ = xdot_at(x0, guess_.theta);
-    if (options.step_solver == StepSolver::ActiveSet)
+    // The standard method (use_fesd = false) has no free lengths to carry a switch: it always
+    // runs on the homotopy path, whatever step_solver says.
+    if (options.step_solver == StepSolver::ActiveSet && d_.use_fesd)
       active_ = std::make_unique<integrator::ActiveSetStep>(model_, tab_, d_, T_step_, u_, p_);
     StepProblem& first = level(0, 0);
     first.mpcc.finalize();
@@ -153,14 +155,26 @@ class Integrator {
   /// Step `step` (0-based) of N_sim: advances over it with the retry policy, reports progress.
   bool step(int step) {
     careful_ = false;
-    bool ok = active_ && active_set_step();
+    const int newton_before = res_.summary.newton_iterations;
+    const bool by_newton = active_ && active_set_step();
+    bool ok = by_newton;
     if (!ok) {
       ++res_.summary.homotopy_path_steps;
       ok = advance(0);
     }
-    if (options_.on_step)
-      options_.on_step({step + 1, N_sim_, t_, static_cast<int>(last_.rows.size()),
-                        last_.nlp_iterations, last_.comp_residual, last_.status});
+    if (options_.on_step) {
+      StepProgress p{step + 1, N_sim_, t_, 0, 0, 0.0, Status::Success};
+      if (by_newton) {
+        p.active_set_path = true;
+        p.newton_iterations = res_.summary.newton_iterations - newton_before;
+      } else {
+        p.nlps = static_cast<int>(last_.rows.size());
+        p.nlp_iterations = last_.nlp_iterations;
+        p.comp_residual = last_.comp_residual;
+        p.status = last_.status;
+      }
+      options_.on_step(p);
+    }
     if (!ok) fail(step);
     return ok;
   }

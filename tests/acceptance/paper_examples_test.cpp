@@ -155,6 +155,17 @@ TEST_P(PinnedExitTest, LeavesAtOneExactly) {
   Eigen::VectorXd x0(2);
   x0 << 0.0, 0.0;
   IntegratorOptions o = options(c.scheme, c.n_s);
+  // The active-set path (the default) puts the exit on a boundary by theta_r = 0 there: exact
+  // without pins, and it runs no homotopy step.
+  const auto a = fesd::integrate(sign_model(0, 1, true), x0, c.T, c.N_sim, o);
+  ASSERT_EQ(a.status, fesd::Status::Success) << a.message;
+  EXPECT_EQ(a.summary.homotopy_path_steps, 0);
+  ASSERT_GE(a.switches.size(), 1u);
+  EXPECT_NEAR(a.switches.back().t, 1.0, 5e-8);
+  EXPECT_NEAR(a.x_final()[0], (c.T - 1) * (c.T - 1) / 2, 5e-8);
+
+  // The homotopy path: exact with the exit pinned.
+  o.step_solver = fesd::StepSolver::Homotopy;
   const auto r = fesd::integrate(sign_model(0, 1, true), x0, c.T, c.N_sim, o);
   ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
   EXPECT_GE(r.summary.pinned_exits, 1);
@@ -239,8 +250,9 @@ namespace {
 TEST(Oscillator, FailedStepIsRetriedWithMoreElements) {
   const fesd::Pss model = fesd_bench::oscillator_model();
   const double T = std::numbers::pi / 2;
-  const auto r =
-      fesd::integrate(model, fesd_bench::oscillator_x0(), T, 8, options(RkScheme::ExplicitRK, 2));
+  IntegratorOptions o = options(RkScheme::ExplicitRK, 2);
+  o.step_solver = fesd::StepSolver::Homotopy;  // the retry policy is the homotopy path's
+  const auto r = fesd::integrate(model, fesd_bench::oscillator_x0(), T, 8, o);
   ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
   EXPECT_GE(r.summary.refined_steps + r.summary.split_steps, 1);
   EXPECT_GE(r.summary.refine_attempts, r.summary.refined_steps);

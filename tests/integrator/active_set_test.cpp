@@ -116,7 +116,9 @@ TEST(ActiveSetOscillator, SameAsHomotopyRadau3) {
 TEST(ActiveSetOscillator, ProblemFileKeyAndOverride) {
   fesd::SimulationProblem q =
       fesd::load_simulation_problem(FESD_SOURCE_DIR "/examples/oscillator.toml");
-  EXPECT_EQ(q.options.step_solver, StepSolver::Homotopy);  // the default
+  EXPECT_EQ(q.options.step_solver, StepSolver::ActiveSet);  // the default
+  fesd::apply_override(q, "step_solver", "homotopy");
+  EXPECT_EQ(q.options.step_solver, StepSolver::Homotopy);
   fesd::apply_override(q, "step_solver", "active_set");
   EXPECT_EQ(q.options.step_solver, StepSolver::ActiveSet);
   const IntegratorResult r = fesd::integrate(q.model, q.x0, q.T_sim, 40, q.options, q.u, q.p);
@@ -132,6 +134,7 @@ Both run_file(const std::string& file,
   fesd::SimulationProblem q = fesd::load_simulation_problem(FESD_SOURCE_DIR "/examples/" + file);
   for (const auto& [key, value] : overrides) fesd::apply_override(q, key, value);
   Both b;
+  fesd::apply_override(q, "step_solver", "homotopy");
   b.homotopy = fesd::integrate(q.model, q.x0, q.T_sim, q.N_sim, q.options, q.u, q.p);
   fesd::apply_override(q, "step_solver", "active_set");
   b.active = fesd::integrate(q.model, q.x0, q.T_sim, q.N_sim, q.options, q.u, q.p);
@@ -414,16 +417,16 @@ step_solver = "fast"
   }
 }
 
-TEST(ActiveSetOptions, NeedsFesd) {
+// The standard method (use_fesd = false) has no free lengths to carry a switch: whatever
+// step_solver says (the default is active_set), every step runs on the homotopy path.
+TEST(ActiveSetOptions, StandardMethodRunsOnTheHomotopy) {
   IntegratorOptions o = options(RkScheme::RadauIIA, 2, StepSolver::ActiveSet);
   o.discretization.use_fesd = false;
-  const auto errors = fesd::validate(o);
-  ASSERT_EQ(errors.size(), 1u);
-  EXPECT_NE(errors[0].find("step_solver"), std::string::npos) << errors[0];
-  EXPECT_NE(errors[0].find("use_fesd"), std::string::npos) << errors[0];
-  EXPECT_THROW(
-      (void)fesd::integrate(crossing_model(), Eigen::VectorXd::Constant(1, -1.0), 1.0, 2, o),
-      fesd::InvalidOption);
+  EXPECT_TRUE(fesd::validate(o).empty());
+  const auto r = fesd::integrate(crossing_model(), Eigen::VectorXd::Constant(1, -1.0), 1.0, 2, o);
+  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+  EXPECT_EQ(r.summary.active_set_path_steps, 0);
+  EXPECT_EQ(r.summary.homotopy_path_steps, 2);
 }
 
 }  // namespace

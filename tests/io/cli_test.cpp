@@ -433,6 +433,13 @@ TEST(Cli, SimulateCarriesAnErrorEstimate) {
                            "  run with N_sim = 8: success"})
     EXPECT_TRUE(contains(r.err, line)) << r.err;
   EXPECT_TRUE(contains(r.err, "  run 3  step    8/8")) << r.err;  // steps numbered by run
+  // Every step by Newton (the default step_solver): the progress says so, and the report has
+  // the active-set line but no NLP or IPOPT lines.
+  EXPECT_TRUE(contains(r.err, "Newton   2  (active set)       success")) << r.err;
+  EXPECT_FALSE(contains(r.err, "NLPs ")) << r.err;
+  EXPECT_TRUE(contains(r.out, "  active-set steps     2  (0 by the homotopy; ")) << r.out;
+  EXPECT_FALSE(contains(r.out, "NLPs solved")) << r.out;
+  EXPECT_FALSE(contains(r.out, "IPOPT")) << r.out;
   EXPECT_TRUE(contains(r.out, "  error estimate       ")) << r.out;
   EXPECT_TRUE(contains(r.out, "  runs                 N_sim = 2, 4, 8  (")) << r.out;
   const nlohmann::json j = nlohmann::json::parse(read_file(json));
@@ -449,7 +456,7 @@ TEST(Cli, NumericalFailureExits1AndStillWrites) {
   TempDir dir;
   const std::string json = dir.file("failed.json");
   const CliRun r = run_cli({"simulate", kOscillator, "--N_sim", "2", "--T_sim", "0.1", "--max_iter",
-                            "1", "--json", json, "--quiet"});
+                            "1", "--step_solver", "homotopy", "--json", json, "--quiet"});
   EXPECT_EQ(r.code, 1) << r.out << r.err;
   EXPECT_EQ(r.err_lines(), 1) << r.err;
   EXPECT_TRUE(contains(r.err, "fesd: error: ")) << r.err;

@@ -17,6 +17,8 @@ TEST(KktSolver, DenseAndMumpsGiveTheSameIntegration) {
   const Eigen::VectorXd x0 = fesd_bench::oscillator_x0();
   fesd::IntegratorOptions automatic, mumps;
   automatic.discretization.n_s = mumps.discretization.n_s = 3;
+  // IPOPT's KKT solvers: the homotopy path (the active-set path runs no NLP).
+  automatic.step_solver = mumps.step_solver = fesd::StepSolver::Homotopy;
   automatic.nlp.kkt_solver = fesd::KktSolver::Dense;
   mumps.nlp.extra = {{"linear_solver", "mumps"}};
   // 1.2 s with 8 steps crosses the circle at t = 1: switch, sliding-free crossing, both regions.
@@ -24,6 +26,8 @@ TEST(KktSolver, DenseAndMumpsGiveTheSameIntegration) {
   const auto b = fesd::integrate(model, x0, 1.2, 8, mumps);
   ASSERT_EQ(a.status, fesd::Status::Success) << a.message;
   ASSERT_EQ(b.status, fesd::Status::Success) << b.message;
+  ASSERT_FALSE(a.homotopy.empty() || a.homotopy.front().empty());
+  ASSERT_FALSE(b.homotopy.empty() || b.homotopy.front().empty());
   EXPECT_EQ(a.homotopy.front().front().linear_solver, "dense");
   EXPECT_EQ(b.homotopy.front().front().linear_solver, "mumps");
   ASSERT_EQ(a.switches.size(), 1u);
@@ -40,9 +44,11 @@ TEST(KktSolver, DenseAndMumpsGiveTheSameIntegration) {
 TEST(KktSolver, AutoIsSparseForSmallNlps) {
   fesd::IntegratorOptions o;
   o.discretization.n_s = 3;
+  o.step_solver = fesd::StepSolver::Homotopy;
   const auto r =
       fesd::integrate(fesd_bench::oscillator_model(), fesd_bench::oscillator_x0(), 0.3, 2, o);
   ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+  ASSERT_FALSE(r.homotopy.empty() || r.homotopy.front().empty());
   EXPECT_EQ(r.homotopy.front().front().linear_solver, "sparse_ldl");
 }
 
