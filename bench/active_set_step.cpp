@@ -13,7 +13,13 @@
 // and the IPOPT iterations per step, the steps each path solved, the error of x(T) against the
 // exact value and of the switch times (the largest).
 //
-//   active_set_step [--N 40] [--repeat R] [--repeat-active RA] [--csv FILE] [--json FILE]
+// Built with Debian's libsundials-dev present (optional), a second table puts the oscillator on
+// the active-set path beside CVODE with root finding (bench/cvode/), both timed in-process over
+// repeated runs: CVODE's rtol is scanned and the largest one whose error is <= --cvode-error
+// (4e-7) is the comparison; fesd's row is the oscillator of the first table (N_sim = --N).
+//
+//   active_set_step [--N 40] [--repeat R] [--repeat-active RA] [--cvode-error E] [--csv FILE]
+//                   [--json FILE]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -32,12 +38,15 @@
 #include "bench_args.hpp"
 #include "oscillator_model.hpp"
 #include "sensitivity_ocp.hpp"
+#ifdef FESD_BENCH_CVODE
+#include "cvode/cvode_oscillator.hpp"
+#endif
 
 namespace fesd_bench {
 [[noreturn]] void usage(const std::string& why, int exit_code) {
   std::fprintf(stderr,
                "active_set_step: %s\nusage: active_set_step [--N 40] [--repeat R] "
-               "[--repeat-active RA] [--csv FILE] [--json FILE]\n",
+               "[--repeat-active RA] [--cvode-error E] [--csv FILE] [--json FILE]\n",
                why.c_str());
   std::exit(exit_code);
 }
@@ -162,6 +171,7 @@ Row measure(const Case& c, int N_sim, fesd::StepSolver solver, int repeats) {
 int main(int argc, char** argv) {
   using fesd_bench::parse_int;
   int N_sim = 40, repeat = 3, repeat_active = 200;
+  double cvode_error = 4e-7;
   std::string csv, json_path;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -173,6 +183,8 @@ int main(int argc, char** argv) {
       repeat = parse_int(a, v);
     else if (a == "--repeat-active")
       repeat_active = parse_int(a, v);
+    else if (a == "--cvode-error")
+      cvode_error = fesd_bench::parse_double(a, v);
     else if (a == "--csv")
       csv = v;
     else if (a == "--json")
@@ -251,6 +263,53 @@ int main(int argc, char** argv) {
         r.nlps_per_step, fmt::format("{}/{}", r.active_set_steps, r.homotopy_steps), r.error_x,
         r.error_t_s, base.cpu_s / r.cpu_s);
   }
+  nlohmann::json cvode_json = nlohmann::json::array();
+#ifdef FESD_BENCH_CVODE
+  {
+    // rows[1]: the oscillator on the active-set path. Its stepping time: integrate() less setup.
+    const Row& as = rows[1];
+    const double fesd_steps_s = as.cpu_s - as.setup_s;
+    fmt::print(
+        "\nOscillator (47) against CVODE with root finding (in-process CPU time, medians of {} "
+        "runs; CVODE atol = rtol / 100, Adams + fixed point and BDF + dense Newton with the exact "
+        "Jacobian)\n",
+        repeat_active);
+    fmt::print("{:<34} {:>9} {:>9} {:>9} {:>9} {:>8} {:>10}\n", "", "err x(T)", "err t_s",
+               "solve ms", "setup ms", "steps", "fesd/this");
+    fmt::print("{:<34} {:>9.1e} {:>9.1e} {:>9.4f} {:>9.4f} {:>8} {:>10}\n",
+               fmt::format("fesd active_set, N_sim = {}", as.N_sim), as.error_x, as.error_t_s,
+               1e3 * fesd_steps_s, 1e3 * as.setup_s, as.N_sim, "");
+    for (bool bdf : {false, true}) {
+      bool chosen = false;
+      for (double rtol : {1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11}) {
+        const fesd_bench::CvodeRun c =
+            fesd_bench::cvode_oscillator(rtol, rtol / 100, bdf, repeat_active);
+        const bool pick = !chosen && c.ok && c.error_x <= cvode_error;
+        chosen = chosen || pick;
+        fmt::print("{:<34} {:>9.1e} {:>9.1e} {:>9.4f} {:>9.4f} {:>8} {:>9.1f}x{}\n",
+                   fmt::format("CVODE {} rtol = {:.0e}", bdf ? "BDF  " : "Adams", rtol), c.error_x,
+                   c.error_t_s, 1e3 * c.solve_s, 1e3 * c.setup_s, c.steps, fesd_steps_s / c.solve_s,
+                   pick ? "  <- equal error" : "");
+        cvode_json.push_back({{"method", bdf ? "bdf" : "adams"},
+                              {"rtol", rtol},
+                              {"atol", c.atol},
+                              {"ok", c.ok},
+                              {"error_x", c.error_x},
+                              {"error_t_s", c.error_t_s},
+                              {"solve_s", c.solve_s},
+                              {"setup_s", c.setup_s},
+                              {"steps", c.steps},
+                              {"rhs_evals", c.rhs_evals},
+                              {"root_evals", c.root_evals},
+                              {"equal_error_pick", pick},
+                              {"fesd_steps_s", fesd_steps_s},
+                              {"fesd_over_cvode", fesd_steps_s / c.solve_s}});
+      }
+    }
+  }
+#else
+  fmt::print("\n(no CVODE comparison: built without libsundials-dev)\n");
+#endif
   if (!csv.empty()) {
     std::ofstream f(csv);
     f << "problem,path,N_sim,repeats,wall_s,cpu_s,cpu_s_per_step,newton_per_step,"
@@ -284,7 +343,7 @@ int main(int argc, char** argv) {
                    {"error_t_s", r.error_t_s},
                    {"path_s", r.path_s},
                    {"setup_s", r.setup_s}});
-    std::ofstream(json_path) << j.dump(2) << "\n";
+    std::ofstream(json_path) << nlohmann::json{{"rows", j}, {"cvode", cvode_json}}.dump(2) << "\n";
   }
   return 0;
 }

@@ -85,6 +85,9 @@ struct Summary {
   int homotopy_path_steps = 0;
   /// Newton iterations of the active-set path, failed tries included.
   int newton_iterations = 0;
+  /// Jacobians evaluated and LU-factored by the active-set path: simplified Newton reuses the LU
+  /// of a step before while the iteration contracts (docs/active-set.md).
+  int newton_factorizations = 0;
   /// Square systems solved (or tried) by the active-set path: 1 per step without a switch,
   /// more where a switch is located.
   int active_set_tries = 0;

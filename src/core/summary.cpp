@@ -57,9 +57,10 @@ std::string format_work(const Summary& s, double per_step) {
   };
   if (s.active_set_path_steps > 0)
     out += fmt::format(
-        "  active-set steps     {}  ({} by the homotopy; {} Newton iterations{}, {:.3f} s)\n",
+        "  active-set steps     {}  ({} by the homotopy; {} Newton iterations{}, {} LU "
+        "factorizations, {:.3f} s)\n",
         s.active_set_path_steps, s.homotopy_path_steps, s.newton_iterations,
-        per(s.newton_iterations, "step"), s.active_set_s);
+        per(s.newton_iterations, "step"), s.newton_factorizations, s.active_set_s);
   // Every step by Newton: no NLP, nothing to say about IPOPT.
   const bool nlps = s.homotopy_steps > 0 || s.active_set_path_steps == 0;
   if (nlps) {

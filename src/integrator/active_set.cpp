@@ -82,7 +82,7 @@ ActiveSetStep::ActiveSetStep(const Pss& model, const Tableau& tab, const Discret
 
 bool ActiveSetStep::solve(const Eigen::VectorXd& x0, const std::vector<int>& prediction,
                           const dcs::LpSolution& lp, const Eigen::VectorXd& xdot) {
-  iterations_ = tries_ = 0;
+  iterations_ = tries_ = factorizations_ = 0;
   kind_ = Kind::Prediction;
   fix(nlp_, in_.s0, x0);
   w_ = nlp_.x_init;
@@ -117,8 +117,22 @@ bool ActiveSetStep::solve(const Eigen::VectorXd& x0, const std::vector<int>& pre
   predicted_sets_.assign(iv_->N_FE(), predicted);
   const Sets& predicted_sets = predicted_sets_;
   const Violation v = check_signs(predicted_sets);
+  if (!v.bad && v.r < 0) return true;
+  if (chord_converged_) {
+    // A switch (or a bad h) in a step whose prediction converged with the LU of a step before:
+    // solved again as if no LU were held, so that every step that switches, and every square
+    // system it tries, goes through the singularity check of a fresh factorization (a stale LU
+    // can converge where the system of this step is singular: temperature_control at the triple
+    // point psi = 1, w = 0).
+    // (its Newton iterations and factorizations are counted, the discarded try is not)
+    const int iterations = iterations_, factorizations = factorizations_;
+    lu_current_ = false;
+    const bool ok = solve(x0, prediction, lp, xdot);
+    iterations_ += iterations;
+    factorizations_ += factorizations;
+    return ok;
+  }
   if (v.bad) return false;
-  if (v.r < 0) return true;
 
   // A switch inside the step: region v.r enters (v.exit: leaves). Its time from lambda_r (theta_r),
   // linear between the last point where the sign held and the first where it failed.
@@ -253,17 +267,57 @@ bool ActiveSetStep::sliding_is_filippov(const Sets& active, int k, int b) const 
 }
 
 ActiveSetTry ActiveSetStep::newton(const Sets& active, const std::vector<nlp::Bound>& extra) {
-  const discretization::FesdInterval& iv = *iv_;
   if (!shape_valid_ || !same_shape(active, extra)) restrict_to(active, extra);
   // the start state (the only bounds that change between steps of one shape)
   for (int j : in_.s0) lb_[j] = ub_[j] = nlp_.x_lb[j];
   for (int j : fixed_) w_[j] = lb_[j];
+  const int n_eq = nlp_.num_constraints() + static_cast<int>(equal_.size());
+  if (n_eq != static_cast<int>(free_.size())) return {};  // not square: not handled here
+  chord_converged_ = false;
+  if (!lu_current_) return iterate(false);
+  // The LU of a step before with this shape: simplified Newton from it first; where that does
+  // not converge, Newton with fresh Jacobians from the same start.
+  w_start_.resize(w_.size());  // sized once
+  std::copy(w_.begin(), w_.end(), w_start_.begin());
+  ActiveSetTry out = iterate(true);
+  // Converged: the Jacobian at the solution must be regular (Thm 15's local uniqueness; a stale
+  // LU can converge where it is singular), and its LU is the one held for the next step.
+  chord_converged_ = out.converged && factor();
+  if (chord_converged_) return out;
+  std::copy(w_start_.begin(), w_start_.end(), w_.begin());
+  const int chord_iterations = out.iterations;
+  out = iterate(false);
+  out.iterations += chord_iterations;
+  return out;
+}
+
+bool ActiveSetStep::factor() {
+  lu_current_ = false;
+  if (!nlp_.eval_jac_g(w_.data(), jac_.data())) return false;
+  // the restricted Jacobian: the entries of free columns (zeroed first: an entry may be the sum
+  // of several); the equal-length rows are constant (restrict_to)
+  double* J = J_.data();
+  for (const auto& [e, pos] : jac_map_) J[pos] = 0;
+  for (const auto& [e, pos] : jac_map_) J[pos] += jac_[e];
+  lu_.compute(J_);
+  ++factorizations_;
+  // A singular Jacobian (not square in effect): the smallest pivot of the LU against the
+  // largest. Cheaper than rcond(), whose estimate costs more than the factorization here.
+  const auto pivots = lu_.matrixLU().diagonal().cwiseAbs();
+  lu_current_ = pivots.minCoeff() > 1e-14 * pivots.maxCoeff();
+  return lu_current_;
+}
+
+ActiveSetTry ActiveSetStep::iterate(bool reuse) {
+  const discretization::FesdInterval& iv = *iv_;
   const int m = nlp_.num_constraints();
-  const int n_eq = m + static_cast<int>(equal_.size());
   const int n_free = static_cast<int>(free_.size());
   ActiveSetTry out;
-  if (n_eq != n_free) return out;  // not square: a shape the active-set path does not handle
-  double* J = J_.data();
+  // Newton's method: a Jacobian of every iterate. With `reuse`, simplified Newton with the LU
+  // held until it stops contracting (or kMaxStale iterations), then Newton's method.
+  bool full = !reuse;
+  int stale = 0;         // simplified-Newton iterations so far
+  double dz_before = 0;  // ||dz|| of the iteration before (the contraction test)
   for (int it = 0; it < kMaxNewton; ++it) {
     if (!nlp_.eval_g(w_.data(), g_.data())) return out;
     for (int i = 0; i < m; ++i) F_[i] = g_[i] - nlp_.g_lb[i];
@@ -275,24 +329,22 @@ ActiveSetTry ActiveSetStep::newton(const Sets& active, const std::vector<nlp::Bo
       out.converged = true;
       return out;
     }
-    if (!nlp_.eval_jac_g(w_.data(), jac_.data())) return out;
-    // the restricted Jacobian: the entries of free columns (zeroed first: an entry may be the sum
-    // of several); the equal-length rows are constant (restrict_to)
-    for (const auto& [e, pos] : jac_map_) J[pos] = 0;
-    for (const auto& [e, pos] : jac_map_) J[pos] += jac_[e];
-    lu_.compute(J_);
+    if (full && !factor()) return out;
     dz_ = lu_.solve(-F_);
     ++out.iterations;
     ++iterations_;
-    // A singular Jacobian (not square in effect): the smallest pivot of the LU against the
-    // largest. Cheaper than rcond(), whose estimate costs more than the factorization here.
-    const auto pivots = lu_.matrixLU().diagonal().cwiseAbs();
-    if (!dz_.allFinite() || !(pivots.minCoeff() > 1e-14 * pivots.maxCoeff())) return out;
+    if (!dz_.allFinite()) return out;
     for (int i = 0; i < n_free; ++i) w_[free_[i]] += dz_[i];
-    if (dz_.lpNorm<Eigen::Infinity>() <= 1e-14 * w_max) {
+    const double dz = dz_.lpNorm<Eigen::Infinity>();
+    // A step below round-off counts as converged with a Jacobian of this iterate only (with an
+    // older one the remaining error is not bounded by the step).
+    if (full && dz <= 1e-14 * w_max) {
       out.converged = true;
       return out;
     }
+    // The simplified iteration contracts too slowly: Newton's method from the next iterate.
+    if (!full) full = ++stale >= kMaxStale || (dz_before > 0 && dz > kChordContraction * dz_before);
+    dz_before = dz;
   }
   return out;
 }
@@ -312,6 +364,7 @@ void ActiveSetStep::restrict_to(const Sets& active, const std::vector<nlp::Bound
   shape_ = active;
   shape_extra_ = extra;
   shape_valid_ = true;
+  lu_current_ = false;  // the LU held was of another shape
   lb_ = nlp_.x_lb;
   ub_ = nlp_.x_ub;
   for (const nlp::Bound& bd : iv.active_set_bounds(active)) {

@@ -64,6 +64,8 @@ class ActiveSetStep {
   const std::vector<double>& solution() const { return w_; }
   /// Of the last solve(): Newton iterations and square systems tried (all tries).
   int newton_iterations() const { return iterations_; }
+  /// Jacobians evaluated and factored (simplified Newton reuses them across steps of one shape).
+  int factorizations() const { return factorizations_; }
   int tries() const { return tries_; }
   /// Size of the square system (per active-set shape; the last one solved).
   int system_size() const { return static_cast<int>(free_.size()); }
@@ -78,6 +80,14 @@ class ActiveSetStep {
   /// every stage after the entry (strictly inside the simplex: sliding_is_filippov()).
   static constexpr double kSlidingThetaTol = 1e-6;
   static constexpr int kMaxNewton = 25;
+  /// Simplified Newton: a step whose shape is that of the system solved before starts with the
+  /// LU held (factored at an earlier step) while every Newton step is at most kChordContraction
+  /// of the one before, for at most kMaxStale iterations; then Newton's method (a Jacobian at
+  /// every iterate). A converged simplified iteration is accepted only if the Jacobian at its
+  /// solution is regular (that LU is then held for the next step); a step whose prediction
+  /// converged so and whose signs fail is solved again without the LU held.
+  static constexpr double kChordContraction = 0.25;
+  static constexpr int kMaxStale = 8;
   /// Sign tolerance of theta >= 0, lambda >= 0 (a switch within ~kSignTol / |c'| of a step end
   /// is taken at the step end).
   static constexpr double kSignTol = 1e-9;
@@ -87,6 +97,12 @@ class ActiveSetStep {
   /// Newton's method from w_ with the active sets `active` and the bounds `extra` on top (a
   /// sliding exit: theta_r = 0 at the end of the element before it); w_ is the result.
   ActiveSetTry newton(const Sets& active, const std::vector<nlp::Bound>& extra = {});
+  /// The iterations of newton() from w_ on the current shape; reuse: start with the LU held
+  /// (simplified Newton), else with a Jacobian of w_.
+  ActiveSetTry iterate(bool reuse);
+  /// The Jacobian at w_ restricted to the free columns, LU-factored into lu_; false if an
+  /// evaluation fails or the LU is singular (pivot ratio below 1e-14).
+  bool factor();
   /// The first violated sign in time order, or r = -1 if the signs hold: lambda_r < 0 off the set
   /// (a region entering, exit = false) or theta_r < 0 on it (a region leaving a sliding mode,
   /// exit = true), at time t_bad, with value val_bad; t_ok, val_ok: the last point where that
@@ -151,6 +167,9 @@ class ActiveSetStep {
   std::vector<double> lb_, ub_;
   Eigen::MatrixXd J_;
   Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
+  bool lu_current_ = false;       // lu_ factors a Jacobian of the current shape
+  bool chord_converged_ = false;  // the last newton() converged with the LU of a step before
+  std::vector<double> w_start_;   // newton()'s start, for the restart with fresh Jacobians
   Eigen::VectorXd F_, dz_;
   std::vector<double> g_, jac_;
   Eigen::VectorXd theta_start_;  // theta at the step start (the guess's LP): exit times
@@ -159,7 +178,7 @@ class ActiveSetStep {
   std::vector<int> predicted_;
   Sets sets_, predicted_sets_;
   mutable std::vector<double> t_ok_, val_ok_;
-  int iterations_ = 0, tries_ = 0;
+  int iterations_ = 0, tries_ = 0, factorizations_ = 0;
   Kind kind_ = Kind::Prediction;
 };
 

@@ -206,6 +206,7 @@ class Integrator {
     bool ok = res_.active_set.empty() ? as.solve(x_, lp_active_set(guess_), guess_, guess_xdot_)
                                       : as.solve(x_, res_.active_set.back(), guess_, guess_xdot_);
     sum.newton_iterations += as.newton_iterations();
+    sum.newton_factorizations += as.factorizations();
     sum.active_set_tries += as.tries();
     pieces_.clear();
     if (!ok) {
@@ -264,6 +265,7 @@ class Integrator {
     const bool ok = as.solve(start.x, start.predicted, start.lp, start.xdot);
     Summary& sum = res_.summary;
     sum.newton_iterations += as.newton_iterations();
+    sum.newton_factorizations += as.factorizations();
     sum.active_set_tries += as.tries();
     if (ok) {
       const discretization::FesdInterval& iv = as.interval();

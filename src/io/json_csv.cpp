@@ -63,6 +63,7 @@ json stats(const Summary& s) {
               {"active_set_path_steps", s.active_set_path_steps},
               {"homotopy_path_steps", s.homotopy_path_steps},
               {"newton_iterations", s.newton_iterations},
+              {"newton_factorizations", s.newton_factorizations},
               {"active_set_tries", s.active_set_tries},
               {"active_set_s", number(s.active_set_s)},
               {"pinned_exits", s.pinned_exits},
