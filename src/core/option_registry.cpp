@@ -206,6 +206,9 @@ std::vector<Option> build() {
            kSim, "step_solver", Use::Simulation,
            "per step: the MPCC homotopy (IPOPT), or Newton on the active set's square system", ""),
        [](Option& x) { x.rule = active_set_needs_fesd; });
+  o.push_back(scalar<&T::sensitivities>(
+      kSim, "sensitivities", Use::Simulation,
+      "compute dx(T)/dx0, dx(T)/du, dx(T)/dp (implicit function theorem per step, chained)", ""));
   o.push_back(input(kSim, "u", Use::Simulation,
                     "constant control values, one per control (comma-separated)", "", true));
   o.push_back(input(kSim, "t0", Use::Simulation,
@@ -407,7 +410,8 @@ OptionTarget target_of(const IntegratorOptions& o) {
   return {.discretization = const_cast<DiscretizationOptions*>(&o.discretization),
           .homotopy = const_cast<HomotopyOptions*>(&o.homotopy),
           .nlp = const_cast<NlpOptions*>(&o.nlp),
-          .step_solver = const_cast<StepSolver*>(&o.step_solver)};
+          .step_solver = const_cast<StepSolver*>(&o.step_solver),
+          .sensitivities = const_cast<bool*>(&o.sensitivities)};
 }
 OptionTarget target_of(const OcpOptions& o) {
   return {.discretization = const_cast<DiscretizationOptions*>(&o.discretization),
