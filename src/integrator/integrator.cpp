@@ -381,7 +381,9 @@ class Integrator {
     const std::size_t first_switch = res_.switches.size();
     const double t_step = t_;
     report_held_switches(iv, w, t_step);
+    const std::size_t first_element = res_.active_set.size();
     accept(iv, w);
+    if (res_.sensitivities.available) check_single_changes(first_element, t_step);
     // An exit at the end of the step before, whose pin failed there, is recorded here (the switch
     // at a step boundary belongs to the step that starts at it).
     if (!carried_unlocated_.empty()) mark_switches(first_switch, carried_unlocated_);
@@ -577,6 +579,25 @@ class Integrator {
     sens.p.resize(0, 0);
   }
 
+  /// Thm 19's setting: at every element boundary from `first` on (the one before it included) the
+  /// number of active regions changes by at most one; else the sensitivities are not available.
+  void check_single_changes(std::size_t first, double t_step) {
+    const std::vector<std::vector<int>>& a = res_.active_set;
+    for (std::size_t n = std::max<std::size_t>(first, 1); n < a.size(); ++n) {
+      const auto d = static_cast<long>(a[n].size()) - static_cast<long>(a[n - 1].size());
+      if (std::abs(d) <= 1) continue;
+      const double t = res_.t[n];
+      const double t_keep = t_;
+      t_ = t_step;
+      sensitivity_unavailable(fmt::format(
+          "at t = {:.6g} the active set changes from {} to {} regions (Thm 19 assumes at most one "
+          "change per switch)",
+          t, a[n - 1].size(), a[n].size()));
+      t_ = t_keep;
+      return;
+    }
+  }
+
   /// The step of the homotopy path that starts at x_ (solution of sp, level (k, r)): FESD, the
   /// square system of its final active sets solved again by Newton from its solution
   /// (ActiveSetStep::solve_fixed), then the IFT there; the standard method, the square system of
@@ -593,6 +614,25 @@ class Integrator {
       if (!a) a = std::make_unique<integrator::ActiveSetStep>(model_, tab_, dr, T, u_, p_);
       ok = a->solve_fixed(x_, sp.iv->active_sets(w.data()), *sp.iv, sp.in, w, why) &&
            a->sensitivity(s, why);
+      // Where the homotopy's final active sets do not make a square system with its solution
+      // (e.g. a switch that active_sets() reads in a neighbouring element), the step as the
+      // active-set path solves it, if that reaches the same end state.
+      if (!ok &&
+          a->solve(x_, res_.active_set.empty() ? lp_active_set(guess_) : res_.active_set.back(),
+                   guess_, guess_xdot_)) {
+        const discretization::FesdInterval& iv = a->interval();
+        double diff = 0, scale = 1;
+        for (int i = 0; i < model_.n_x(); ++i) {
+          diff = std::max(
+              diff, std::abs(a->solution()[iv.x(iv.N_FE(), i)] - w[sp.iv->x(sp.iv->N_FE(), i)]));
+          scale = std::max(scale, std::abs(w[sp.iv->x(sp.iv->N_FE(), i)]));
+        }
+        std::string why2;
+        if (diff <= 1e-6 * scale && a->sensitivity(s, why2))
+          ok = true;
+        else
+          why += fmt::format("; the active-set path's solution of the step ends {:.2e} away", diff);
+      }
     } else {
       std::unique_ptr<integrator::StandardStepSensitivity>& a = sens_standard_[{k, r}];
       if (!a)
