@@ -5,7 +5,10 @@
 // e^(A2 (T - 1)) J e^(A1) with the jump matrix (24) J = [[1, 0], [2 omega, 1]]). Thm 19: FESD's
 // error is O(h^q); the standard method's does not go to 0 (Sect. 2.4).
 //
-//   sensitivity_h [--N 8,16,32,64,128] [--csv FILE]
+//   sensitivity_h [--N 8,16,32,64,128] [--path active_set|homotopy] [--csv FILE]
+//
+// --path: FESD's step solver (default active_set; homotopy: the sensitivity at the homotopy's
+// final active set, docs/sensitivities.md).
 //
 // The error is the largest absolute entry of the difference (for Ex. 3(a) the one entry). One
 // table to stdout; progress to stderr.
@@ -29,7 +32,8 @@
 namespace fesd_bench {
 [[noreturn]] void usage(const std::string& why, int exit_code) {
   std::fprintf(stderr,
-               "sensitivity_h: %s\nusage: sensitivity_h [--N 8,16,32,64,128] [--csv FILE]\n",
+               "sensitivity_h: %s\nusage: sensitivity_h [--N 8,16,32,64,128] [--path "
+               "active_set|homotopy] [--csv FILE]\n",
                why.c_str());
   std::exit(exit_code);
 }
@@ -81,12 +85,17 @@ std::vector<Problem> problems() {
 int main(int argc, char** argv) {
   std::vector<int> Ns{8, 16, 32, 64, 128};
   std::string csv;
+  fesd::StepSolver fesd_path = fesd::StepSolver::ActiveSet;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (i + 1 >= argc) fesd_bench::usage("missing value after " + a);
     if (a == "--N")
       Ns = fesd_bench::parse_list(a, argv[++i]);
-    else if (a == "--csv")
+    else if (a == "--path") {
+      const std::string v = argv[++i];
+      if (v != "active_set" && v != "homotopy") fesd_bench::usage("--path: active_set or homotopy");
+      fesd_path = v == "homotopy" ? fesd::StepSolver::Homotopy : fesd::StepSolver::ActiveSet;
+    } else if (a == "--csv")
       csv = argv[++i];
     else
       fesd_bench::usage("unknown argument " + a);
@@ -107,7 +116,7 @@ int main(int argc, char** argv) {
         o.discretization.rk_scheme = m.scheme;
         o.discretization.n_s = m.n_s;
         o.discretization.use_fesd = m.fesd;
-        o.step_solver = m.fesd ? fesd::StepSolver::ActiveSet : fesd::StepSolver::Homotopy;
+        o.step_solver = m.fesd ? fesd_path : fesd::StepSolver::Homotopy;
         o.sensitivities = true;
         std::fprintf(stderr, "%s %s N_sim = %d\n", pb.name.c_str(), m.name.c_str(), N);
         const fesd::IntegratorResult r = fesd::integrate(pb.model, pb.x0, pb.T, N, o);
