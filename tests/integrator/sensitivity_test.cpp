@@ -14,6 +14,7 @@
 #include "../../bench/sensitivity_ocp.hpp"
 #include "fesd/integrator.hpp"
 #include "fesd/model.hpp"
+#include "fesd/problem_file.hpp"
 
 namespace {
 
@@ -227,6 +228,45 @@ TEST(IftFiniteDifferences, SmoothModel) {
   EXPECT_LT((rh.sensitivities.x0 - r.sensitivities.x0).lpNorm<Eigen::Infinity>(), 1e-8);
   EXPECT_LT((rh.sensitivities.u - r.sensitivities.u).lpNorm<Eigen::Infinity>(), 1e-8);
   EXPECT_LT((rh.sensitivities.p - r.sensitivities.p).lpNorm<Eigen::Infinity>(), 1e-8);
+}
+
+// Outside Thm 19's setting: x1' in -sign(x1), x2' in -sign(x2) from (1, 1) reach both surfaces at
+// t = 1 at once (two regions enter in one switch, co-dimension 2). The step from 6/7 has no regular
+// square system at its final active set: not available, with the step named, on both paths;
+// the simulation itself succeeds.
+TEST(IftNotAvailable, TwoSimultaneousEntries) {
+  const std::string text = R"(
+[model]
+x = ["x1", "x2"]
+x0 = [1, 1]
+[[model.subsystem]]
+c = ["x1"]
+F = [["-1", "0"], ["1", "0"]]
+[[model.subsystem]]
+g = ["-x2", "x2"]
+F = [["0", "-1"], ["0", "1"]]
+[simulation]
+T_sim = 3.0
+N_sim = 7
+sensitivities = true
+[discretization]
+rk_scheme = "radau_iia"
+n_s = 2
+N_finite_elements = 2
+)";
+  fesd::SimulationProblem q = fesd::parse_simulation_problem(text, "product.toml");
+  ASSERT_TRUE(q.options.sensitivities);
+  for (StepSolver solver : {StepSolver::ActiveSet, StepSolver::Homotopy}) {
+    q.options.step_solver = solver;
+    const IntegratorResult r = fesd::integrate(q.model, q.x0, q.T_sim, q.N_sim, q.options);
+    ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+    EXPECT_TRUE(r.sensitivities.requested);
+    EXPECT_FALSE(r.sensitivities.available);
+    EXPECT_NE(r.sensitivities.message.find("the step from t = 0.857143"), std::string::npos)
+        << r.sensitivities.message;
+    EXPECT_EQ(r.sensitivities.x0.size(), 0);
+    EXPECT_NE(r.full_report().find("sensitivities        not available"), std::string::npos);
+  }
 }
 
 // Not requested: nothing computed, nothing reported.
