@@ -162,6 +162,31 @@ TEST(IftOscillator, ExactJumpMatrixProduct) {
   }
 }
 
+// The oscillator as printed in examples/oscillator.toml, omega a parameter: x(T) = e^(T - 1)
+// Rot(omega (T - 2)) (1, 0) for every omega near 2 pi (the crossing stays at t_s = 1, where the
+// radius e^(t - 1) reaches 1), so dx(T)/domega = e^(T - 1) (T - 2) (-sin omega (T - 2),
+// cos omega (T - 2)). Measured: 5.3e-9 (Radau IIA 3, N_FE = 2, N_sim = 100, both paths).
+TEST(IftOscillator, ParameterOmega) {
+  fesd::SimulationProblem q =
+      fesd::load_simulation_problem(FESD_SOURCE_DIR "/examples/oscillator.toml");
+  ASSERT_EQ(q.model.n_p(), 1);
+  const double w = 2 * std::numbers::pi, T = q.T_sim, a = w * (T - 2);
+  const Eigen::Vector2d exact =
+      std::exp(T - 1) * (T - 2) * Eigen::Vector2d(-std::sin(a), std::cos(a));
+  q.options.sensitivities = true;
+  for (StepSolver solver : {StepSolver::ActiveSet, StepSolver::Homotopy}) {
+    q.options.step_solver = solver;
+    const IntegratorResult r = fesd::integrate(q.model, q.x0, T, q.N_sim, q.options);
+    expect_available(r);
+    ASSERT_EQ(r.sensitivities.p.rows(), 2);
+    ASSERT_EQ(r.sensitivities.p.cols(), 1);
+    const double err = (r.sensitivities.p.col(0) - exact).lpNorm<Eigen::Infinity>();
+    EXPECT_LT(err, 1e-6) << r.sensitivities.p;
+    RecordProperty(solver == StepSolver::ActiveSet ? "error_active_set" : "error_homotopy",
+                   fmt::format("{:.3e}", err));
+  }
+}
+
 // A smooth model with controls and parameters and no switch near the trajectory: a forced,
 // damped oscillator x1' = x2, x2' = -p0 x1 - p1 x2 + u0 + u1 x1, c = x1 - 10 (never reached;
 // region 1, c < 0, the whole time).
