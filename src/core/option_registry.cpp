@@ -206,13 +206,13 @@ std::vector<Option> build() {
            kSim, "step_solver", Use::Simulation,
            "per step: the MPCC homotopy (IPOPT), or Newton on the active set's square system", ""),
        [](Option& x) { x.rule = active_set_needs_fesd; });
-  o.push_back(scalar<&T::sensitivities>(
-      kSim, "sensitivities", Use::Simulation,
-      "compute dx(T)/dx0, dx(T)/du, dx(T)/dp (implicit function theorem per step, chained)", ""));
   o.push_back(input(kSim, "u", Use::Simulation,
                     "constant control values, one per control (comma-separated)", "", true));
   o.push_back(input(kSim, "t0", Use::Simulation,
                     "initial value of the clock state (only used if t appears)", "", true));
+  o.push_back(scalar<&T::sensitivities>(
+      kSim, "sensitivities", Use::Simulation,
+      "compute dx(T)/dx0, dx(T)/du, dx(T)/dp (implicit function theorem per step, chained)", ""));
 
   // [ocp]: the horizon, costs, constraints, bounds and guesses (include/fesd/ocp.hpp).
   const Use ocp = Use::Ocp;
