@@ -580,19 +580,30 @@ class Integrator {
   }
 
   /// Thm 19's setting: at every element boundary from `first` on (the one before it included) the
-  /// number of active regions changes by at most one; else the sensitivities are not available.
+  /// number of active regions changes by at most one, and (FESD) no switch lies on the boundary
+  /// `first` itself, a step boundary: a fixed time, not a free element length, so the IFT cannot
+  /// move the switch (Example 3(a) with t_s = 1/3 on a step boundary gives 1, not 1/3). Else the
+  /// sensitivities are not available.
   void check_single_changes(std::size_t first, double t_step) {
     const std::vector<std::vector<int>>& a = res_.active_set;
     for (std::size_t n = std::max<std::size_t>(first, 1); n < a.size(); ++n) {
       const auto d = static_cast<long>(a[n].size()) - static_cast<long>(a[n - 1].size());
-      if (std::abs(d) <= 1) continue;
-      const double t = res_.t[n];
+      std::string why;
+      if (std::abs(d) > 1)
+        why = fmt::format(
+            "at t = {:.6g} the active set changes from {} to {} regions (Thm 19 assumes at most "
+            "one change per switch)",
+            res_.t[n], a[n - 1].size(), a[n].size());
+      else if (n == first && d_.use_fesd && a[n] != a[n - 1])
+        why = fmt::format(
+            "the switch at t = {:.6g} lies on a step boundary, a fixed time (not a free element "
+            "boundary), where the derivative of the switch time is lost; another N_sim moves it "
+            "inside a step",
+            res_.t[n]);
+      if (why.empty()) continue;
       const double t_keep = t_;
       t_ = t_step;
-      sensitivity_unavailable(fmt::format(
-          "at t = {:.6g} the active set changes from {} to {} regions (Thm 19 assumes at most one "
-          "change per switch)",
-          t, a[n - 1].size(), a[n].size()));
+      sensitivity_unavailable(why);
       t_ = t_keep;
       return;
     }
