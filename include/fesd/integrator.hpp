@@ -59,6 +59,21 @@ struct Accuracy {
   std::string note;               ///< one sentence: how the estimate was made, or why there is none
 };
 
+/// dx(T)/dx0, dx(T)/du, dx(T)/dp of the simulation (IntegratorOptions::sensitivities;
+/// docs/sensitivities.md): per step the implicit function theorem on the step's square system
+/// (its active sets fixed; Thm 15, eq. (24) and Thm 19 of papers/fesd-filippov.txt), chained over
+/// the steps. u is the one constant control of the whole simulation, so dx(T)/du sums the
+/// contributions of every step.
+struct Sensitivities {
+  bool requested = false;  ///< IntegratorOptions::sensitivities was set
+  bool available = false;  ///< computed for every step (x0, u, p valid)
+  /// Why not available: the first step whose square system failed, or the integration's failure.
+  std::string message;
+  Eigen::MatrixXd x0;  ///< n_x x n_x
+  Eigen::MatrixXd u;   ///< n_x x n_u
+  Eigen::MatrixXd p;   ///< n_x x n_p
+};
+
 /// The result of integrate(). Time grid = all finite-element boundaries t_0 < ... < t_{N_sim N_FE}
 /// (more elements where steps were refined or split, Summary::refined_steps, split_steps).
 struct IntegratorResult {
@@ -83,6 +98,8 @@ struct IntegratorResult {
   Summary summary;
   /// The error estimate and the runs behind it (simulate() only).
   Accuracy accuracy;
+  /// dx(T)/dx0, dx(T)/du, dx(T)/dp (IntegratorOptions::sensitivities).
+  Sensitivities sensitivities;
 
   Eigen::VectorXd x_final() const { return x.empty() ? Eigen::VectorXd() : x.back(); }
   std::vector<double> switch_times() const;

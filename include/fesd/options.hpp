@@ -205,6 +205,10 @@ struct IntegratorOptions {
   /// Called after every integration step (the CLI prints format_step_progress() of it); the
   /// library itself never prints.
   StepCallback on_step;
+  /// `sensitivities` ([simulation]): compute dx(T)/dx0, dx(T)/du, dx(T)/dp by the implicit
+  /// function theorem on every step's square system, chained over the steps
+  /// (IntegratorResult::sensitivities; docs/sensitivities.md).
+  bool sensitivities = false;
 };
 
 /// Empty if valid, else one line per broken rule: "discretization.n_s = 0: must be >= 1".

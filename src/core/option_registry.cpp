@@ -204,6 +204,9 @@ std::vector<Option> build() {
                     "constant control values, one per control (comma-separated)", "", true));
   o.push_back(input(kSim, "t0", Use::Simulation,
                     "initial value of the clock state (only used if t appears)", "", true));
+  o.push_back(scalar<&T::sensitivities>(
+      kSim, "sensitivities", Use::Simulation,
+      "compute dx(T)/dx0, dx(T)/du, dx(T)/dp (implicit function theorem per step, chained)", ""));
 
   // [ocp]: the horizon, costs, constraints, bounds and guesses (include/fesd/ocp.hpp).
   const Use ocp = Use::Ocp;
@@ -401,7 +404,8 @@ OptionTarget target_of(const IntegratorOptions& o) {
   return {.discretization = const_cast<DiscretizationOptions*>(&o.discretization),
           .homotopy = const_cast<HomotopyOptions*>(&o.homotopy),
           .nlp = const_cast<NlpOptions*>(&o.nlp),
-          .step_solver = const_cast<StepSolver*>(&o.step_solver)};
+          .step_solver = const_cast<StepSolver*>(&o.step_solver),
+          .sensitivities = const_cast<bool*>(&o.sensitivities)};
 }
 OptionTarget target_of(const OcpOptions& o) {
   return {.discretization = const_cast<DiscretizationOptions*>(&o.discretization),

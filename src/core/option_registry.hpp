@@ -49,6 +49,7 @@ struct OptionTarget {
   int* N_sim_max = nullptr;
   bool* error_estimate = nullptr;     ///< simulate()'s companion runs (AccuracyOptions)
   StepSolver* step_solver = nullptr;  ///< IntegratorOptions::step_solver
+  bool* sensitivities = nullptr;      ///< IntegratorOptions::sensitivities
   Ocp* ocp = nullptr;                 ///< [ocp] keys stored in the problem
   OcpOptions* ocp_options = nullptr;  ///< [ocp] keys stored in the solver options
 };

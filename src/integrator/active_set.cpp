@@ -7,6 +7,8 @@
 #include <limits>
 #include <numeric>
 
+#include <fmt/format.h>
+
 #include "fesd/error.hpp"
 
 namespace fesd::integrator {
@@ -216,6 +218,67 @@ bool ActiveSetStep::solve(const Eigen::VectorXd& x0, const std::vector<int>& pre
     return true;
   }
   return false;
+}
+
+bool ActiveSetStep::solve_fixed(const Eigen::VectorXd& x0, const Sets& active,
+                                const discretization::FesdInterval& other,
+                                const discretization::IntervalInputs& other_in,
+                                const std::vector<double>& w_other, std::string& why) {
+  const discretization::FesdInterval& iv = *iv_;
+  iterations_ = tries_ = 0;
+  fix(nlp_, in_.s0, x0);
+  w_ = nlp_.x_init;
+  copy_interval(model_, other, w_other, iv, w_);
+  for (int r = 0; r < model_.n_theta(); ++r)
+    w_[in_.lambda_start[r]] = w_other[other_in.lambda_start[r]];
+  for (int k = 0; k < model_.n_sys(); ++k) w_[in_.mu_start[k]] = w_other[other_in.mu_start[k]];
+  // the switch conditions of sliding exits between elements: theta_r = 0 at the boundary
+  std::vector<nlp::Bound> extra;
+  for (int n = 1; n < iv.N_FE(); ++n)
+    for (int r : discretization::FesdInterval::exit_regions(model_, active[n - 1], active[n])) {
+      if (!iv.can_pin_exits()) {
+        why =
+            "a sliding exit inside the step needs a stiffly accurate scheme (Radau IIA, "
+            "Lobatto IIIC)";
+        return false;
+      }
+      extra.push_back({iv.theta(n - 1, iv.n_s() - 1, r), 0.0, 0.0});
+    }
+  ++tries_;
+  const ActiveSetTry t = newton(active, extra);
+  if (!t.converged) {
+    why =
+        "Newton's method on the square system of the final active set did not converge (not "
+        "square, singular, or no solution near the homotopy's)";
+    return false;
+  }
+  // the polished solution must be the homotopy's (the same switch times and end state)
+  for (int n = 0; n < iv.N_FE(); ++n) {
+    const double t_a = w_[iv.h(n)], t_b = w_other[other.h(n)];
+    if (std::abs(t_a - t_b) > 1e-6 * (1 + std::abs(t_b))) {
+      why = fmt::format(
+          "the square system of the final active set moved element {} from "
+          "h = {:.9g} to {:.9g}",
+          n, t_b, t_a);
+      return false;
+    }
+  }
+  return true;
+}
+
+bool ActiveSetStep::sensitivity(StepSensitivity& out, std::string& why) {
+  const discretization::FesdInterval& iv = *iv_;
+  std::vector<std::pair<int, int>> equal;
+  for (int n : equal_) equal.emplace_back(iv.h(n), iv.h(n - 1));
+  SquareSystem sys(nlp_, free_, std::move(equal));
+  std::vector<int> inputs = in_.s0, x_end;
+  inputs.insert(inputs.end(), in_.q.begin(), in_.q.end());
+  inputs.insert(inputs.end(), in_.p.begin(), in_.p.end());
+  for (int i = 0; i < model_.n_x(); ++i) x_end.push_back(iv.x(iv.N_FE(), i));
+  Eigen::MatrixXd d;
+  if (!sys.ift(w_, inputs, x_end, d, why)) return false;
+  out = split_inputs(d, model_.n_x(), model_.n_u(), model_.n_p());
+  return true;
 }
 
 std::vector<std::vector<int>> ActiveSetStep::selections(const std::vector<int>& prediction,

@@ -21,6 +21,7 @@
 // is reduced to a regular selection (selections()). If no consistent active set is found within
 // kMaxTries square systems, solve() returns false and the integrator uses the homotopy.
 #pragma once
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -31,6 +32,7 @@
 #include "fesd/model.hpp"
 #include "fesd/options.hpp"
 #include "fesd/tableau.hpp"
+#include "integrator/sensitivity.hpp"
 #include "nlp/block_nlp.hpp"
 
 namespace fesd::integrator {
@@ -69,6 +71,19 @@ class ActiveSetStep {
   int tries() const { return tries_; }
   /// Size of the square system (per active-set shape; the last one solved).
   int system_size() const { return static_cast<int>(free_.size()); }
+
+  /// The square system with the active sets `active` (one per element; an exit of a sliding mode
+  /// between elements n-1 and n pinned by theta_r = 0 at the end of element n-1, as in solve())
+  /// solved by Newton from the solution w_other of `other` (an interval of the same scheme and
+  /// N_FE, inputs other_in: the homotopy path's step). False with `why` if it does not converge.
+  bool solve_fixed(const Eigen::VectorXd& x0, const std::vector<std::vector<int>>& active,
+                   const discretization::FesdInterval& other,
+                   const discretization::IntervalInputs& other_in,
+                   const std::vector<double>& w_other, std::string& why);
+  /// d x_end / d(s0, u, p) of the last successful solve() or solve_fixed() by the implicit
+  /// function theorem on its square system (docs/sensitivities.md). False with `why` if the
+  /// system is singular there.
+  bool sensitivity(StepSensitivity& out, std::string& why);
 
   /// What the accepted solution of the last solve() is.
   enum class Kind { Prediction, Crossing, SlidingEntry, Exit };

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -20,6 +21,7 @@
 #include "discretization/fesd_interval.hpp"
 #include "fesd/error.hpp"
 #include "integrator/active_set.hpp"
+#include "integrator/sensitivity.hpp"
 #include "mpcc/problem.hpp"
 #include "nlp/nlp_solver.hpp"
 
@@ -150,6 +152,13 @@ class Integrator {
     solver_ = nlp::make_solver(options_.nlp);
     res_.t.push_back(0.0);
     res_.x.push_back(x0);
+    if (options.sensitivities) {
+      Sensitivities& sens = res_.sensitivities;
+      sens.requested = sens.available = true;
+      sens.x0 = Eigen::MatrixXd::Identity(model_.n_x(), model_.n_x());
+      sens.u = Eigen::MatrixXd::Zero(model_.n_x(), model_.n_u());
+      sens.p = Eigen::MatrixXd::Zero(model_.n_x(), model_.n_p());
+    }
   }
 
   /// Step `step` (0-based) of N_sim: advances over it with the retry policy, reports progress.
@@ -183,6 +192,8 @@ class Integrator {
     if (res_.status == Status::NotRun) {
       res_.status = Status::Success;
       res_.message = std::string(describe(Status::Success));
+    } else if (res_.sensitivities.available) {
+      sensitivity_unavailable("the integration failed");
     }
     res_.summary.wall_s = wall_s;
     return std::move(res_);
@@ -222,12 +233,26 @@ class Integrator {
     last_.active_set_fixed = true;
     res_.homotopy.emplace_back();  // no NLPs: the step's homotopy table is empty
     if (pieces_.empty()) {
+      if (res_.sensitivities.available) {
+        integrator::StepSensitivity s;
+        std::string why;
+        if (as.sensitivity(s, why))
+          chain(s);
+        else
+          sensitivity_unavailable(why);
+      }
       last_.comp_residual =
           mpcc::comp_residual(as.solution().data(), as.interval().residual_pairs());
       commit(as.interval(), as.solution(), last_.comp_residual, {});
       return true;
     }
     for (const Piece& piece : pieces_) {
+      if (res_.sensitivities.available) {
+        if (piece.sens_why.empty())
+          chain(piece.sens);
+        else
+          sensitivity_unavailable(piece.sens_why);
+      }
       const discretization::FesdInterval& iv = active_level(piece.level).interval();
       const double comp = mpcc::comp_residual(piece.w.data(), iv.residual_pairs());
       last_.comp_residual = std::max(last_.comp_residual, comp);
@@ -247,6 +272,8 @@ class Integrator {
   struct Piece {
     int level = 0;
     std::vector<double> w;
+    integrator::StepSensitivity sens;  // with IntegratorOptions::sensitivities
+    std::string sens_why;              // why sens is not available (empty: it is)
   };
 
   /// The square-system solver of level k (steps of length T_step / 2^k), created when first used.
@@ -270,7 +297,11 @@ class Integrator {
     if (ok) {
       const discretization::FesdInterval& iv = as.interval();
       const std::vector<double>& w = as.solution();
-      pieces_.push_back({k, w});
+      pieces_.push_back({k, w, {}, {}});
+      if (res_.sensitivities.available &&
+          !as.sensitivity(pieces_.back().sens, pieces_.back().sens_why) &&
+          pieces_.back().sens_why.empty())
+        pieces_.back().sens_why = "the square system is singular";
       const int last = iv.N_FE() - 1;
       for (int i = 0; i < model_.n_x(); ++i) start.x[i] = w[iv.x(last + 1, i)];
       start.predicted = iv.active_set(w.data(), last);
@@ -353,6 +384,7 @@ class Integrator {
       failed_ = solved;
       return false;
     }
+    if (res_.sensitivities.available) homotopy_sensitivity(k, r, *solved);
     commit(*solved->iv, solved->mpcc.solution(), hr.comp_residual, unlocated);
     return true;
   }
@@ -365,7 +397,9 @@ class Integrator {
     const std::size_t first_switch = res_.switches.size();
     const double t_step = t_;
     report_held_switches(iv, w, t_step);
+    const std::size_t first_element = res_.active_set.size();
     accept(iv, w);
+    if (res_.sensitivities.available) check_single_changes(first_element, t_step);
     // An exit at the end of the step before, whose pin failed there, is recorded here (the switch
     // at a step boundary belongs to the step that starts at it).
     if (!carried_unlocated_.empty()) mark_switches(first_switch, carried_unlocated_);
@@ -538,6 +572,104 @@ class Integrator {
       h0_min = std::max(h0_min, 0.5 * th_end / -rate);
     }
     return h0_min;
+  }
+
+  // ---- sensitivities (IntegratorOptions::sensitivities; docs/sensitivities.md) ----
+
+  /// Chains the map of the step from x_ to its end: D(T) <- S D + dx_end/d(u, p).
+  void chain(const integrator::StepSensitivity& s) {
+    Sensitivities& sens = res_.sensitivities;
+    sens.x0 = s.x0 * sens.x0;
+    sens.u = s.x0 * sens.u + s.u;
+    sens.p = s.x0 * sens.p + s.p;
+  }
+
+  /// The first step (from t_) whose sensitivity is not available ends the chain.
+  void sensitivity_unavailable(const std::string& why) {
+    Sensitivities& sens = res_.sensitivities;
+    if (!sens.available) return;
+    sens.available = false;
+    sens.message = fmt::format("not available: the step from t = {:.6g}: {}", t_, why);
+    sens.x0.resize(0, 0);
+    sens.u.resize(0, 0);
+    sens.p.resize(0, 0);
+  }
+
+  /// Thm 19's setting: at every element boundary from `first` on (the one before it included) the
+  /// number of active regions changes by at most one, and (FESD) no switch lies on the boundary
+  /// `first` itself, a step boundary: a fixed time, not a free element length, so the IFT cannot
+  /// move the switch (Example 3(a) with t_s = 1/3 on a step boundary gives 1, not 1/3). Else the
+  /// sensitivities are not available.
+  void check_single_changes(std::size_t first, double t_step) {
+    const std::vector<std::vector<int>>& a = res_.active_set;
+    for (std::size_t n = std::max<std::size_t>(first, 1); n < a.size(); ++n) {
+      const auto d = static_cast<long>(a[n].size()) - static_cast<long>(a[n - 1].size());
+      std::string why;
+      if (std::abs(d) > 1)
+        why = fmt::format(
+            "at t = {:.6g} the active set changes from {} to {} regions (Thm 19 assumes at most "
+            "one change per switch)",
+            res_.t[n], a[n - 1].size(), a[n].size());
+      else if (n == first && d_.use_fesd && a[n] != a[n - 1])
+        why = fmt::format(
+            "the switch at t = {:.6g} lies on a step boundary, a fixed time (not a free element "
+            "boundary), where the derivative of the switch time is lost; another N_sim moves it "
+            "inside a step",
+            res_.t[n]);
+      if (why.empty()) continue;
+      const double t_keep = t_;
+      t_ = t_step;
+      sensitivity_unavailable(why);
+      t_ = t_keep;
+      return;
+    }
+  }
+
+  /// The step of the homotopy path that starts at x_ (solution of sp, level (k, r)): FESD, the
+  /// square system of its final active sets solved again by Newton from its solution
+  /// (ActiveSetStep::solve_fixed), then the IFT there; the standard method, the square system of
+  /// the stage-wise active sets with h fixed (StandardStepSensitivity).
+  void homotopy_sensitivity(int k, int r, const StepProblem& sp) {
+    const std::vector<double>& w = sp.mpcc.solution();
+    integrator::StepSensitivity s;
+    std::string why;
+    bool ok = false;
+    const DiscretizationOptions dr = level_options(r);
+    const double T = T_step_ / std::ldexp(1.0, k);
+    if (d_.use_fesd) {
+      std::unique_ptr<integrator::ActiveSetStep>& a = sens_fesd_[{k, r}];
+      if (!a) a = std::make_unique<integrator::ActiveSetStep>(model_, tab_, dr, T, u_, p_);
+      ok = a->solve_fixed(x_, sp.iv->active_sets(w.data()), *sp.iv, sp.in, w, why) &&
+           a->sensitivity(s, why);
+      // Where the homotopy's final active sets do not make a square system with its solution
+      // (e.g. a switch that active_sets() reads in a neighbouring element), the step as the
+      // active-set path solves it, if that reaches the same end state.
+      if (!ok &&
+          a->solve(x_, res_.active_set.empty() ? lp_active_set(guess_) : res_.active_set.back(),
+                   guess_, guess_xdot_)) {
+        const discretization::FesdInterval& iv = a->interval();
+        double diff = 0, scale = 1;
+        for (int i = 0; i < model_.n_x(); ++i) {
+          diff = std::max(
+              diff, std::abs(a->solution()[iv.x(iv.N_FE(), i)] - w[sp.iv->x(sp.iv->N_FE(), i)]));
+          scale = std::max(scale, std::abs(w[sp.iv->x(sp.iv->N_FE(), i)]));
+        }
+        std::string why2;
+        if (diff <= 1e-6 * scale && a->sensitivity(s, why2))
+          ok = true;
+        else
+          why += fmt::format("; the active-set path's solution of the step ends {:.2e} away", diff);
+      }
+    } else {
+      std::unique_ptr<integrator::StandardStepSensitivity>& a = sens_standard_[{k, r}];
+      if (!a)
+        a = std::make_unique<integrator::StandardStepSensitivity>(model_, tab_, dr, T, u_, p_);
+      ok = a->compute(x_, *sp.iv, w, s, why);
+    }
+    if (ok)
+      chain(s);
+    else
+      sensitivity_unavailable(why.empty() ? "the square system failed" : why);
   }
 
   // ---- pieces ----
@@ -736,6 +868,10 @@ class Integrator {
   static constexpr int kMaxActiveSplit = 2;
   std::array<std::unique_ptr<integrator::ActiveSetStep>, kMaxActiveSplit> active_split_;
   std::vector<Piece> pieces_;
+  /// The square systems of the homotopy path's steps for their sensitivities, per level (k, r).
+  std::map<std::pair<int, int>, std::unique_ptr<integrator::ActiveSetStep>> sens_fesd_;
+  std::map<std::pair<int, int>, std::unique_ptr<integrator::StandardStepSensitivity>>
+      sens_standard_;
 
   /// The NLP solver of the current attempt: once an attempt of the step has failed (careful_),
   /// and kkt_solver is auto, its retries factor the KKT systems with MUMPS, the fallback of the
@@ -820,6 +956,26 @@ std::string IntegratorResult::full_report() const {
                               static_cast<std::size_t>(summary.split_steps);
   os << fmt::format("  integration steps    {}  ({} finite elements)\n", n_steps, h.size());
   os << format_accuracy(accuracy);
+  if (sensitivities.requested) {
+    const Sensitivities& se = sensitivities;
+    if (!se.available) {
+      os << fmt::format("  sensitivities        {}\n", se.message);
+    } else {
+      const auto matrix = [](const Eigen::MatrixXd& m) {
+        std::string out = "[";
+        for (Eigen::Index i = 0; i < m.rows(); ++i) {
+          out += i ? "; " : "";
+          for (Eigen::Index j = 0; j < m.cols(); ++j)
+            out += fmt::format("{}{:.10g}", j ? ", " : "", m(i, j));
+        }
+        return out + "]";
+      };
+      os << fmt::format("  sensitivities        dx(T)/dx0 = {}", matrix(se.x0));
+      if (se.u.cols() > 0) os << fmt::format(", dx(T)/du = {}", matrix(se.u));
+      if (se.p.cols() > 0) os << fmt::format(", dx(T)/dp = {}", matrix(se.p));
+      os << "\n";
+    }
+  }
   os << format_warnings(summary);
   os << format_work(summary, n_steps == 0 ? 1.0 : static_cast<double>(n_steps));
   return os.str();

@@ -110,6 +110,24 @@ json switches(const std::vector<SwitchEvent>& events) {
   return a;
 }
 
+/// The matrix as rows (row-major nested arrays).
+json matrix(const Eigen::MatrixXd& m) {
+  json out = json::array();
+  for (Eigen::Index i = 0; i < m.rows(); ++i)
+    out.push_back(array(Eigen::VectorXd(m.row(i).transpose())));
+  return out;
+}
+
+json sensitivities(const Sensitivities& s) {
+  json j;
+  j["available"] = s.available;
+  j["message"] = s.message;
+  j["x0"] = matrix(s.x0);
+  j["u"] = matrix(s.u);
+  j["p"] = matrix(s.p);
+  return j;
+}
+
 json homotopy_row(const HomotopyRow& r) {
   return json{{"k", r.k},
               {"sigma", number(r.sigma)},
@@ -258,6 +276,7 @@ void write_json(const IntegratorResult& result, const Pss& model, const std::str
   j["switches"] = switches(result.switches);
   j["homotopy"] = homotopy(result.homotopy);
   j["state_names"] = state_names_of(result, model);
+  if (result.sensitivities.requested) j["sensitivities"] = sensitivities(result.sensitivities);
   std::string text;
   pretty(j, 0, text);
   text += '\n';

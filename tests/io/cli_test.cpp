@@ -787,4 +787,33 @@ TEST(CliDocs, ReadmeCommandsRun) {
   EXPECT_EQ(run, 3);
 }
 
+// --sensitivities true (docs/sensitivities.md): Example 3(a), dx(T)/dx0 = 1/3 in the summary and
+// in the JSON entry `sensitivities` (row-major nested arrays; no controls, no parameters).
+TEST(Cli, SensitivitiesInSummaryAndJson) {
+  ASSERT_TRUE(fs::exists(kCrossing)) << kCrossing << " is missing";
+  TempDir dir;
+  const std::string json = dir.file("r.json");
+  const CliRun r = run_cli({"simulate", kCrossing, "--sensitivities", "true", "--error_estimate",
+                            "false", "--step_solver", "active_set", "--json", json});
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_TRUE(contains(r.out, "sensitivities        dx(T)/dx0 = [0.3333333333]")) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(read_file(json));
+  ASSERT_TRUE(j.contains("sensitivities")) << j.dump();
+  const nlohmann::json& s = j["sensitivities"];
+  EXPECT_EQ(s["available"], true);
+  ASSERT_EQ(s["x0"].size(), 1u);
+  ASSERT_EQ(s["x0"][0].size(), 1u);
+  EXPECT_NEAR(s["x0"][0][0].get<double>(), 1.0 / 3.0, 1e-9);
+  EXPECT_EQ(s["u"].size(), 1u);
+  EXPECT_TRUE(s["u"][0].empty());
+  EXPECT_TRUE(s["p"][0].empty());
+
+  // without the option: no entry
+  const CliRun plain =
+      run_cli({"simulate", kCrossing, "--error_estimate", "false", "--json", json});
+  ASSERT_EQ(plain.code, 0) << plain.out << plain.err;
+  EXPECT_FALSE(nlohmann::json::parse(read_file(json)).contains("sensitivities"));
+  EXPECT_FALSE(contains(plain.out, "sensitivities")) << plain.out;
+}
+
 }  // namespace
