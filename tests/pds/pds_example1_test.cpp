@@ -1,0 +1,104 @@
+// Example 1 of papers/fesd-pds.txt against its exact solution (REFERENCE.md): the flow
+// f(x) = (x2, -x1) on circles, kept in C = {x2 >= -1}. From x0 = (sqrt 2, sqrt 2) (radius 2) the
+// state reaches x2 = -1 at t = 5 pi/12, slides along it to (0, -1) (leaving at 5 pi/12 + sqrt 3)
+// and follows the unit circle to x(T) = (-1, 0) at T = 11 pi/12 + sqrt 3. One FESD interval over
+// [0, T] with N_FE elements (N_sim = 1), Radau IIA, default homotopy (complementarity_tol 1e-9,
+// IPOPT tol 1e-12). Tolerances are about 3x the measured values (docs/pds.md).
+#include <cmath>
+#include <numbers>
+
+#include <gtest/gtest.h>
+
+#include "fesd/error.hpp"
+#include "fesd/pds.hpp"
+
+namespace {
+
+using std::numbers::pi;
+
+struct Example1 {
+  template <class T>
+  void c(const T* x, const T*, T* c) const {
+    c[0] = x[1] + 1.0;
+  }
+  template <class T>
+  void f(const T* x, const T*, const T*, T* f) const {
+    f[0] = x[1];
+    f[1] = -x[0];
+  }
+};
+
+fesd::Pds example1() {
+  return fesd::make_pds(Example1{}, fesd::PdsDims{.n_x = 2, .n_c = 1});
+}
+const double kT = 11 * pi / 12 + std::sqrt(3.0);
+const double kContact = 5 * pi / 12, kLeave = 5 * pi / 12 + std::sqrt(3.0);
+Eigen::VectorXd x0() {
+  return Eigen::Vector2d(std::sqrt(2.0), std::sqrt(2.0));
+}
+
+fesd::IntegratorOptions options(int n_s, int N_FE, bool fesd,
+                                fesd::RkScheme scheme = fesd::RkScheme::RadauIIA) {
+  fesd::IntegratorOptions o;
+  o.discretization.rk_scheme = scheme;
+  o.discretization.n_s = n_s;
+  o.discretization.N_FE = N_FE;
+  o.discretization.use_fesd = fesd;
+  return o;
+}
+
+double error(const fesd::IntegratorResult& r) {
+  return (r.x_final() - Eigen::Vector2d(-1.0, 0.0)).norm();
+}
+
+struct Case {
+  int n_s, N_FE;
+  double x_tol, t_tol;  // ||x(T) - (-1, 0)||, |t_switch - exact|
+};
+
+class PdsExample1 : public ::testing::TestWithParam<Case> {};
+
+// Measured (n_s, N_FE): x(T) error, contact / leaving time error
+//   (2, 20) 3.9e-4, 1.2e-4 / 3.1e-4     (2, 40) 6.0e-5, 1.9e-5 / 5.2e-5
+//   (3, 10) 9.3e-6, 1.9e-6 / 4.7e-6     (3, 20) 1.9e-7, 5.5e-8 / 2.5e-7
+TEST_P(PdsExample1, FesdContactAndLeavingOnElementBoundaries) {
+  const Case c = GetParam();
+  const auto r = fesd::integrate(example1(), x0(), kT, 1, options(c.n_s, c.N_FE, true));
+  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+  EXPECT_LT(error(r), c.x_tol);
+  EXPECT_NEAR(r.t.back(), kT, 1e-12);
+  EXPECT_LE(r.summary.max_comp_residual, 1e-9);
+  // Two switches: contact (no active constraint -> c_1 active), leaving (the reverse), both at
+  // element boundaries (SwitchEvent::t is a boundary t_n by construction).
+  ASSERT_EQ(r.switches.size(), 2u);
+  EXPECT_TRUE(r.switches[0].before.empty());
+  EXPECT_EQ(r.switches[0].after, std::vector<int>{0});
+  EXPECT_NEAR(r.switches[0].t, kContact, c.t_tol);
+  EXPECT_EQ(r.switches[1].before, std::vector<int>{0});
+  EXPECT_TRUE(r.switches[1].after.empty());
+  EXPECT_NEAR(r.switches[1].t, kLeave, c.t_tol);
+  // On the boundary while sliding: x2 = -1 at the element ends between the switches.
+  for (std::size_t n = 0; n < r.t.size(); ++n)
+    if (r.t[n] > kContact + c.t_tol && r.t[n] < kLeave - c.t_tol) {
+      EXPECT_NEAR(r.x[n][1], -1.0, 1e-9) << "t = " << r.t[n];
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(RadauIIA, PdsExample1,
+                         ::testing::Values(Case{2, 20, 1.2e-3, 1e-3}, Case{2, 40, 2e-4, 1.5e-4},
+                                           Case{3, 10, 3e-5, 1.5e-5}, Case{3, 20, 6e-7, 8e-7}));
+
+// The standard method (6) with the same grid: the switch inside an element costs it its order.
+// Measured: n_s = 2, N_FE = 20: 5.0e-3 (FESD 3.9e-4); N_FE = 40: 1.7e-3 (FESD 6.0e-5).
+TEST(PdsExample1Standard, FesdMuchMoreAccurateAtEqualElements) {
+  for (int N_FE : {20, 40}) {
+    const auto fesd = fesd::integrate(example1(), x0(), kT, 1, options(2, N_FE, true));
+    const auto standard = fesd::integrate(example1(), x0(), kT, 1, options(2, N_FE, false));
+    ASSERT_EQ(fesd.status, fesd::Status::Success) << fesd.message;
+    ASSERT_EQ(standard.status, fesd::Status::Success) << standard.message;
+    EXPECT_LT(10 * error(fesd), error(standard)) << "N_FE = " << N_FE;
+    for (double h : standard.h) EXPECT_NEAR(h, kT / N_FE, 1e-14);
+  }
+}
+
+}  // namespace
