@@ -5,36 +5,21 @@
 // [0, T] with N_FE elements (N_sim = 1), Radau IIA, default homotopy (complementarity_tol 1e-9,
 // IPOPT tol 1e-12). Tolerances are about 3x the measured values (docs/pds.md).
 #include <cmath>
-#include <numbers>
 
 #include <gtest/gtest.h>
 
+#include "../../bench/pds_example1_model.hpp"
 #include "fesd/error.hpp"
 #include "fesd/pds.hpp"
 
 namespace {
 
-using std::numbers::pi;
-
-struct Example1 {
-  template <class T>
-  void c(const T* x, const T*, T* c) const {
-    c[0] = x[1] + 1.0;
-  }
-  template <class T>
-  void f(const T* x, const T*, const T*, T* f) const {
-    f[0] = x[1];
-    f[1] = -x[0];
-  }
-};
-
+using pds_example1::kContact;
+using pds_example1::kLeave;
+using pds_example1::kT;
+using pds_example1::x0;
 fesd::Pds example1() {
-  return fesd::make_pds(Example1{}, fesd::PdsDims{.n_x = 2, .n_c = 1});
-}
-const double kT = 11 * pi / 12 + std::sqrt(3.0);
-const double kContact = 5 * pi / 12, kLeave = 5 * pi / 12 + std::sqrt(3.0);
-Eigen::VectorXd x0() {
-  return Eigen::Vector2d(std::sqrt(2.0), std::sqrt(2.0));
+  return pds_example1::model();
 }
 
 fesd::IntegratorOptions options(int n_s, int N_FE, bool fesd,
