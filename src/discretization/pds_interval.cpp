@@ -92,6 +92,12 @@ std::vector<std::string> PdsInterval::errors(const Tableau& tab, const Discretiz
         "rk_scheme = {}: projected dynamical systems support only schemes with c_n_s = 1 whose "
         "last stage is the element end (radau_iia, lobatto_iiic), papers/fesd-pds.txt Sect. III-A",
         to_string(tab.scheme)));
+  if (o.use_fesd && tab.scheme == RkScheme::LobattoIIIC)
+    e.push_back(
+        "rk_scheme = lobatto_iiic with use_fesd: its first stage (c_1 = 0) is not a point of "
+        "the trajectory, and where the state leaves the boundary of C, (8a) sets lambda = 0 "
+        "there while c(x_{n,1}) < 0 (measured on Example 1: the homotopy stalls at a residual of "
+        "5e-6); use radau_iia, or use_fesd = false");
   if (o.use_fesd && tab.n_s < 2)
     e.push_back(
         "n_s = 1 with use_fesd: the step equilibration of papers/fesd-pds.txt Sect. III-C needs "

@@ -1,7 +1,7 @@
 // src/discretization/pds_interval.hpp: the equations of one interval [0, T] of a projected
 // dynamical system (include/fesd/pds.hpp) with N_FE finite elements and an n_s-stage RK method
-// with c_{n_s} = 1 (Radau IIA, Lobatto IIIC), papers/fesd-pds.txt Sect. III, written into a
-// BlockNlp (docs/pds.md):
+// with c_{n_s} = 1 (Radau IIA; Lobatto IIIC for the standard method only), papers/fesd-pds.txt
+// Sect. III, written into a BlockNlp (docs/pds.md):
 //
 //   per element n and stage i (lifted stage derivatives V and constraint values C):
 //     V_{n,i} = f(X_{n,i}, q, p) + grad c(X_{n,i}) lambda_{n,i}               (6a)
@@ -44,7 +44,7 @@ struct PdsIntervalInputs {
 class PdsInterval {
  public:
   /// Throws fesd::InvalidOption for a scheme without c_{n_s} = 1 and stiff accuracy (only Radau
-  /// IIA and Lobatto IIIC are supported), FESD with n_s < 2 or N_FE < 2, or M <= 0.
+  /// IIA and Lobatto IIIC; FESD: Radau IIA only), FESD with n_s < 2 or N_FE < 2, or M <= 0.
   PdsInterval(const Pds& model, const Tableau& tableau, const DiscretizationOptions& options,
               const PdsOptions& pds_options);
 

@@ -39,6 +39,7 @@ double error(const fesd::IntegratorResult& r) {
 struct Case {
   int n_s, N_FE;
   double x_tol, t_tol;  // ||x(T) - (-1, 0)||, |t_switch - exact|
+  fesd::RkScheme scheme = fesd::RkScheme::RadauIIA;
 };
 
 class PdsExample1 : public ::testing::TestWithParam<Case> {};
@@ -48,7 +49,7 @@ class PdsExample1 : public ::testing::TestWithParam<Case> {};
 //   (3, 10) 9.3e-6, 1.9e-6 / 4.7e-6     (3, 20) 1.9e-7, 5.5e-8 / 2.5e-7
 TEST_P(PdsExample1, FesdContactAndLeavingOnElementBoundaries) {
   const Case c = GetParam();
-  const auto r = fesd::integrate(example1(), x0(), kT, 1, options(c.n_s, c.N_FE, true));
+  const auto r = fesd::integrate(example1(), x0(), kT, 1, options(c.n_s, c.N_FE, true, c.scheme));
   ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
   EXPECT_LT(error(r), c.x_tol);
   EXPECT_NEAR(r.t.back(), kT, 1e-12);
@@ -84,6 +85,14 @@ TEST(PdsExample1Standard, FesdMuchMoreAccurateAtEqualElements) {
     EXPECT_LT(10 * error(fesd), error(standard)) << "N_FE = " << N_FE;
     for (double h : standard.h) EXPECT_NEAR(h, kT / N_FE, 1e-14);
   }
+}
+
+// Lobatto IIIC with the standard method (6): measured n_s = 3, N_FE = 10: 1.26e-2.
+TEST(PdsExample1Standard, LobattoIIIC) {
+  const auto r =
+      fesd::integrate(example1(), x0(), kT, 1, options(3, 10, false, fesd::RkScheme::LobattoIIIC));
+  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+  EXPECT_LT(error(r), 4e-2);
 }
 
 }  // namespace
