@@ -347,4 +347,22 @@ std::vector<int> PdsInterval::active_set(const double* w, int n) const {
   return active;
 }
 
+std::vector<nlp::Bound> PdsInterval::active_set_bounds(const double* w) const {
+  std::vector<std::vector<int>> active(N_FE_);
+  for (int n = 0; n < N_FE_; ++n) active[n] = active_set(w, n);
+  auto has = [](const std::vector<int>& a, int k) {
+    return std::find(a.begin(), a.end(), k) != a.end();
+  };
+  std::vector<nlp::Bound> bounds;
+  for (int n = 0; n < N_FE_; ++n)
+    for (int k = 0; k < model_.n_c(); ++k) {
+      const bool on = has(active[n], k);
+      for (int i = 0; i < n_s_; ++i)
+        bounds.push_back({on ? C(n, i, k) : lambda(n, i, k), 0.0, 0.0});
+      if (n + 1 < N_FE_ && on != has(active[n + 1], k))
+        bounds.push_back({on ? lambda(n, n_s_ - 1, k) : C(n, n_s_ - 1, k), 0.0, 0.0});
+    }
+  return bounds;
+}
+
 }  // namespace fesd::discretization

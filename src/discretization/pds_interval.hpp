@@ -82,6 +82,15 @@ class PdsInterval {
   /// Active constraints of element n at w: k with sum_i lambda_{n,i,k} > sum_i C_{n,i,k} (the
   /// factor that vanishes is the smaller one).
   std::vector<int> active_set(const double* w, int n) const;
+  /// The bounds of the re-solve with the active set of every element fixed (FESD,
+  /// HomotopyOptions::fix_active_set): constraint k active in element n: C_{n,i,k} = 0 at every
+  /// stage; inactive: lambda_{n,i,k} = 0 at every stage; and at a boundary where k switches
+  /// (Prop. 3: k in W_{n-1,n_s}) both factors of the last stage before it are 0: C_{n-1,n_s,k}
+  /// where k becomes active (contact), lambda_{n-1,n_s,k} where it becomes inactive (leaving).
+  /// Complementarity then holds exactly, and the contact and leaving points are the equations
+  /// c(x_n) = 0 and lambda_{n-1,n_s} = 0 instead of products <= sigma (whose tolerance lets a
+  /// leaving point drift by up to complementarity_tol / c(x_{n,1}), growing as h shrinks).
+  std::vector<nlp::Bound> active_set_bounds(const double* w) const;
 
  private:
   int idx(int n, int i) const { return n * n_s_ + i; }

@@ -205,6 +205,22 @@ IntegratorResult integrate(const Pds& model, const Eigen::VectorXd& x0, double T
       res.summary.setup_s = seconds_since(t_start);
     }
     mpcc::HomotopyResult hr = mpcc.solve_homotopy(*solver, options.homotopy);
+    // The re-solve with the active set of every element fixed (PdsInterval::active_set_bounds);
+    // if it fails, the homotopy's solution stays.
+    if (hr.status == Status::Success && d.use_fesd && options.homotopy.fix_active_set) {
+      mpcc::HomotopyResult again =
+          mpcc.solve_again(*solver, options.homotopy, iv.active_set_bounds(mpcc.solution().data()));
+      const Status homotopy_status = hr.status;
+      mpcc::append(hr, again);
+      if (again.status == Status::Success) {
+        ++res.summary.active_set_solves;
+        hr.active_set_fixed = true;
+      } else {
+        ++res.summary.active_set_failures;
+        hr.status = homotopy_status;
+        hr.comp_residual = mpcc::comp_residual(mpcc.solution().data(), iv.residual_pairs());
+      }
+    }
     ++res.summary.homotopy_path_steps;
     res.homotopy.emplace_back();
     mpcc::add_to_summary(hr, res.summary, res.homotopy.back());
