@@ -137,9 +137,13 @@ Pds make_pds(Model model, PdsDims dims) {
 /// Options of the PDS discretization that the Stewart DCS has not.
 struct PdsOptions {
   /// M > 0 of the step equilibration -nu_n M <= h_{n-1} - h_n <= nu_n M (Sect. III-C; the paper
-  /// asks M >> 1 and gives no value). nu_n is min(pi_c, pi_lambda) of the sums (10), which at a
-  /// switch is of the size of c and lambda over one element; M = 1e3 lets h move freely there.
-  double M = 1e3;
+  /// asks M >> 1 and gives no value). nu_n = min(pi_c, pi_lambda) of the sums (10) is small at a
+  /// leaving point close to an element end: c grows quadratically after leaving, so sigma_c^F of
+  /// a short element is O(h^2) (Example 1, N_sim = 100 steps of 2 elements: nu = 4e-6 where h
+  /// had to change by 0.04, M = 1e3 failed). Where nothing switches, nu_n = 0 exactly after the
+  /// fixed-active-set re-solve, whatever M; during the homotopy the h_penalty term keeps h from
+  /// drifting. Default 1e6 (docs/pds.md).
+  double M = 1e6;
   /// FESD: add rho_h / N_FE sum_n ((h_n - h0) / h0)^2 to the objective (h0 = T / N_FE). The
   /// paper's integrator NLP has no objective; without one, the relaxed NLPs of the homotopy
   /// (where nu_n > 0 at every boundary) leave h free and IPOPT drifts to solutions with collapsed

@@ -87,6 +87,19 @@ TEST(PdsExample1Standard, FesdMuchMoreAccurateAtEqualElements) {
   }
 }
 
+// A step that starts sliding on x2 = -1 at (a, -1) and leaves at t = a, 6% before its end: the
+// element after the leaving point is short and c grows quadratically there, so nu_n is ~4e-6
+// (the step of Example 1 that failed with M = 1e3 at N_sim = 100). Exact: x(T) =
+// (-sin(T - a), -cos(T - a)). Measured (n_s = 3, N_FE = 2): error 1e-16, leaving time 3e-16.
+TEST(PdsExample1Step, LeavingCloseToTheStepEnd) {
+  const double a = 0.04335, T = kT / 100;
+  const auto r = fesd::integrate(example1(), Eigen::Vector2d(a, -1.0), T, 1, options(3, 2, true));
+  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+  EXPECT_LT((r.x_final() - Eigen::Vector2d(-std::sin(T - a), -std::cos(T - a))).norm(), 1e-12);
+  ASSERT_EQ(r.switches.size(), 1u);
+  EXPECT_NEAR(r.switches[0].t, a, 1e-12);
+}
+
 // Lobatto IIIC with the standard method (6): measured n_s = 3, N_FE = 10: 1.26e-2.
 TEST(PdsExample1Standard, LobattoIIIC) {
   const auto r =
