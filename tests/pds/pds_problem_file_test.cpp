@@ -13,6 +13,7 @@
 #include "../../bench/pds_example1_model.hpp"
 #include "fesd/error.hpp"
 #include "fesd/pds_problem_file.hpp"
+#include "fesd/problem_file.hpp"
 #include "support/temp_dir.hpp"
 
 namespace {
@@ -154,6 +155,22 @@ TEST(PdsCli, UnsupportedOutputsAndOverridesExitTwo) {
     EXPECT_EQ(r.code, 2) << extra;
     EXPECT_NE(r.err.find("not supported for projected models"), std::string::npos) << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
+}
+
+}  // namespace
+
+namespace {
+
+// A projected file given to the piecewise smooth loader (`fesd check`): says what it is.
+TEST(PdsProblemFile, PiecewiseSmoothLoaderNamesTheKind) {
+  try {
+    fesd::parse_simulation_problem(kExample1, "f.toml");
+    FAIL() << "no exception";
+  } catch (const fesd::ProblemFileError& e) {
+    EXPECT_NE(std::string(e.what()).find("model.kind: a projected dynamical system"),
+              std::string::npos)
+        << e.what();
   }
 }
 
