@@ -27,6 +27,7 @@
 #include <cstring>
 #include <exception>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <iostream>
 #include <new>
@@ -46,6 +47,7 @@
 #include "fesd/io.hpp"
 #include "fesd/ocp.hpp"
 #include "fesd/options.hpp"
+#include "fesd/pds_problem_file.hpp"
 #include "fesd/problem_file.hpp"
 #include "fesd/status.hpp"
 #include "fesd/tableau.hpp"
@@ -618,7 +620,56 @@ Problem prepare(const SolveArgs& args, const CLI::App& cmd) {
   return problem;
 }
 
+/// `fesd simulate` of a projected dynamical system ([model] kind = "projected", docs/pds.md): the
+/// header, integrate() and the report; --csv writes t and x at the element boundaries. JSON,
+/// plots and command-line overrides are not supported for these models yet (exit 2).
+int run_simulate_pds(const SolveArgs& args, const CLI::App& cmd) {
+  for (const char* option : {"--json", "--plot"})
+    if (cmd.count(option) > 0)
+      throw UsageError(fmt::format(
+          "{} is not supported for projected models ([model] kind = \"projected\") yet", option));
+  if (!args.overrides.pairs().empty())
+    throw UsageError(
+        "command-line overrides are not supported for projected models ([model] kind = "
+        "\"projected\") yet");
+  const fesd::PdsSimulationProblem problem = fesd::load_pds_simulation_problem(args.file);
+  if (!args.quiet) {
+    const fesd::DiscretizationOptions& d = problem.options.discretization;
+    out::print("{} ({}): projected dynamical system, n_x = {}, n_c = {}\n", problem.name,
+               problem.source, problem.model.n_x(), problem.model.n_c());
+    if (!problem.description.empty()) out::print("  {}\n", problem.description);
+    out::print("  x0          {}\n", join_vector(problem.x0, problem.model.state_names));
+    out::print("  scheme      {}, n_s = {}, N_FE = {}, use_fesd = {}\n",
+               fesd::to_string(d.rk_scheme), d.n_s, d.N_FE, yes_no(d.use_fesd));
+    out::print("  simulation  T_sim = {:g}, N_sim = {}\n\n", problem.T_sim, problem.N_sim);
+    flush_stdout();
+  }
+  const fesd::IntegratorResult result = fesd::simulate(problem);
+  out::print("{}\n", result.full_report());
+  if (cmd.count("--csv") > 0) {
+    std::ofstream f(args.csv);
+    if (!f) throw fesd::IoError(fmt::format("{}: cannot write CSV", args.csv));
+    f << "t";
+    for (const std::string& name : problem.model.state_names) f << "," << name;
+    f << "\n";
+    for (std::size_t n = 0; n < result.t.size(); ++n) {
+      f << fmt::format("{:.17g}", result.t[n]);
+      for (Eigen::Index i = 0; i < result.x[n].size(); ++i)
+        f << fmt::format(",{:.17g}", result.x[n][i]);
+      f << "\n";
+    }
+    if (!f) throw fesd::IoError(fmt::format("{}: cannot write CSV", args.csv));
+    out::print("wrote CSV  {}\n", args.csv);
+  }
+  if (result.status != fesd::Status::Success)
+    print_error(fmt::format("the simulation failed ({}): {}", fesd::to_string(result.status),
+                            result.message));
+  return fesd::exit_code(result.status);
+}
+
 int run_simulate(const SolveArgs& args, const CLI::App& cmd) {
+  check_input_file(args.file);
+  if (fesd::is_projected_problem_file(args.file)) return run_simulate_pds(args, cmd);
   const auto problem = prepare<fesd::SimulationProblem>(args, cmd);
   // One progress line per run (N_sim chosen by tol_sim, or the companions of the estimate).
   std::function<void(const fesd::AccuracyRun&)> on_run;

@@ -78,6 +78,14 @@ SimulationProblem parse_simulation_problem(std::string_view toml_text,
                : "this is an optimal control problem (an [ocp] table, expected [simulation]): "
                  "solve it with `fesd solve` or fesd::load_ocp_problem");
   r.check_keys(root, kTopKeys, "");
+  // A projected dynamical system is read by load_pds_simulation_problem (docs/pds.md).
+  if (const toml::node* m = root.get("model"))
+    if (const toml::table* mt = m->as_table())
+      if (const toml::node* kind = mt->get("kind"))
+        r.fail(kind->source(), "model.kind",
+               "a projected dynamical system (kind = \"projected\") is not a piecewise smooth "
+               "model: only `fesd simulate` and fesd::load_pds_simulation_problem read it "
+               "(docs/pds.md)");
 
   SimulationProblem problem;
   read_name(r, root, source_name, problem);

@@ -876,5 +876,14 @@ const std::string& Expression::text() const {
 #define FESD_EXPRESSION_INSTANTIATE(T) template T Expression::evaluate<T>(const T*) const;
 FESD_FOR_EACH_SCALAR(FESD_EXPRESSION_INSTANTIATE)
 #undef FESD_EXPRESSION_INSTANTIATE
+// One directional derivative on top of the Hessian types (grad c(x) lambda of a
+// projected dynamical system's constraints, model/expression_pds.cpp; Dual<Jet<N>> = Hyper<N> is
+// above, and double takes Jet<8>).
+#define FESD_EXPRESSION_INSTANTIATE_DUAL(T) \
+  template ad::Dual<T> Expression::evaluate<ad::Dual<T>>(const ad::Dual<T>*) const;
+FESD_EXPRESSION_INSTANTIATE_DUAL(::fesd::ad::Hyper<8>)
+FESD_EXPRESSION_INSTANTIATE_DUAL(::fesd::ad::Hyper<32>)
+FESD_EXPRESSION_INSTANTIATE_DUAL(::fesd::ad::Hyper<128>)
+#undef FESD_EXPRESSION_INSTANTIATE_DUAL
 
 }  // namespace fesd::expr

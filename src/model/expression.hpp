@@ -19,7 +19,8 @@
 //
 // evaluate<T>() runs the program on a scratch array of values (on the stack for double, Jet<8>
 // and Hyper<8>, else one array per thread and type) and allocates nothing in steady state. It is
-// instantiated for every type of FESD_FOR_EACH_SCALAR (include/fesd/ad.hpp) and for no other.
+// instantiated for every type of FESD_FOR_EACH_SCALAR (include/fesd/ad.hpp), and for ad::Dual of
+// Hyper<N> (one directional derivative more: model/expression_pds.cpp), and for no other.
 #pragma once
 #include <memory>
 #include <string>

@@ -1,0 +1,44 @@
+// include/fesd/pds_problem_file.hpp: simulation problem files of projected dynamical systems
+// (docs/pds.md, "Problem files"): [model] kind = "projected" with a vector field `f` and
+// `constraints` (C = {x : constraints >= 0}), read into a fesd::Pds.
+#pragma once
+#include <string>
+#include <string_view>
+
+#include <Eigen/Dense>
+
+#include "fesd/integrator.hpp"
+#include "fesd/options.hpp"
+#include "fesd/pds.hpp"
+
+namespace fesd {
+
+/// A projected dynamical system and its simulation, as read from a problem file.
+struct PdsSimulationProblem {
+  std::string name;         ///< `name`, or the file's stem
+  std::string description;  ///< `description`, may be empty
+  std::string source;       ///< file path (or the name given to parse_pds_simulation_problem)
+  Pds model;
+  Eigen::VectorXd x0, u, p;
+  double T_sim = 0;
+  int N_sim = 0;  ///< required (> 0): tol_sim is not supported for projected models yet
+  IntegratorOptions options;
+  PdsOptions pds;
+};
+
+/// Whether the file's [model] table says kind = "projected" (only the top level and [model] kind
+/// are read; other mistakes are the loaders'). Throws fesd::ProblemFileError if the file cannot be
+/// read or is not valid TOML.
+bool is_projected_problem_file(const std::string& path);
+
+/// Reads and validates a projected-system simulation file. Throws fesd::ProblemFileError /
+/// ExpressionError / InvalidOption / InvalidModel with "file:line: what is wrong" messages.
+PdsSimulationProblem load_pds_simulation_problem(const std::string& path);
+/// Same, from text; `source_name` is used in messages.
+PdsSimulationProblem parse_pds_simulation_problem(std::string_view toml_text,
+                                                  std::string_view source_name);
+
+/// integrate() of the problem (N_sim steps).
+IntegratorResult simulate(const PdsSimulationProblem& problem);
+
+}  // namespace fesd

@@ -1,0 +1,207 @@
+// src/io/pds_problem_file.cpp: simulation problem files of projected dynamical systems
+// ([model] kind = "projected", docs/pds.md "Problem files") -> PdsSimulationProblem. Shares the
+// typed reader and the option tables with problem_file.cpp; the [model] table has its own keys.
+#include "fesd/pds_problem_file.hpp"
+
+#include <array>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include "fesd/error.hpp"
+#include "fesd/problem_file.hpp"
+#include "io/option_target.hpp"
+#include "io/problem_file_reader.hpp"
+#include "model/expression_pds.hpp"
+
+namespace fesd {
+namespace {
+
+using namespace io_detail;
+
+constexpr std::array<std::string_view, 7> kTopKeys{
+    "name", "description", "model", "simulation", "discretization", "homotopy", "ipopt"};
+constexpr std::array<std::string_view, 8> kPdsModelKeys{"kind", "x",           "u", "p",
+                                                        "x0",   "constraints", "f", "x0_tol"};
+// Keys of piecewise smooth models: a projected model must not have them.
+constexpr std::array<std::string_view, 5> kPssKeys{"c", "S", "g", "F", "subsystem"};
+constexpr registry::Use kKind = registry::Use::Simulation;
+
+const toml::table* model_table(const toml::table& root) {
+  const toml::node* m = root.get("model");
+  return m != nullptr ? m->as_table() : nullptr;
+}
+
+}  // namespace
+
+bool is_projected_problem_file(const std::string& path) {
+  const toml::table root = parse_toml(read_problem_text(path), path);
+  const toml::table* m = model_table(root);
+  if (m == nullptr) return false;
+  const toml::node* kind = m->get("kind");
+  return kind != nullptr && kind->as_string() != nullptr && kind->as_string()->get() == "projected";
+}
+
+PdsSimulationProblem parse_pds_simulation_problem(std::string_view toml_text,
+                                                  std::string_view source_name) {
+  const Reader r{std::string(source_name)};
+  const toml::table root = parse_toml(toml_text, source_name);
+  if (const toml::node* ocp = root.get("ocp"))
+    r.fail(ocp->source(), "ocp",
+           "optimal control of projected systems is not supported yet (expected [simulation])");
+  r.check_keys(root, kTopKeys, "");
+  PdsSimulationProblem problem;
+  read_name(r, root, source_name, problem);
+
+  // ---- [model] ----
+  const toml::node* model_node = root.get("model");
+  if (model_node == nullptr)
+    r.fail(toml::source_region{}, "model",
+           "missing table [model] (expected kind = \"projected\", x, x0, f and constraints)");
+  const toml::table& model = r.table(*model_node, "model");
+  for (std::string_view k : kPssKeys)
+    if (const toml::node* n = model.get(k))
+      r.fail(n->source(), join("model", k),
+             fmt::format("'{}' belongs to piecewise smooth models; a projected model (kind = "
+                         "\"projected\") has one vector field `f` and its set C = {{x : "
+                         "constraints(x) >= 0}} in `constraints`: the two kinds cannot be mixed",
+                         k));
+  r.check_keys(model, kPdsModelKeys, "model");
+  const toml::node* kind = model.get("kind");
+  if (kind == nullptr || r.string(*kind, "model.kind") != "projected")
+    r.fail(kind != nullptr ? kind->source() : model.source(), "model.kind",
+           "expected \"projected\"");
+  auto required = [&](std::string_view key, std::string_view what) -> const toml::node& {
+    const toml::node* n = model.get(key);
+    if (n == nullptr)
+      r.fail(model.source(), "model", fmt::format("missing key '{}' (expected {})", key, what));
+    return *n;
+  };
+  std::vector<std::string> x_names, u_names, p_names;
+  std::vector<double> p_values;
+  std::set<std::string> seen;
+  auto add_names = [&](const toml::node& n, std::string_view path, std::vector<std::string>& out) {
+    for (const auto& [name, node] : r.names(n, path)) {
+      if (!is_identifier(name))
+        r.fail(node->source(), path, fmt::format("'{}' is not a valid name", name));
+      if (name == "t")
+        r.fail(node->source(), path, "'t' is the time, which projected models do not support yet");
+      if (!seen.insert(name).second)
+        r.fail(node->source(), path, fmt::format("'{}' is used twice", name));
+      out.push_back(name);
+    }
+  };
+  add_names(required("x", "the state names, e.g. x = [\"x1\", \"x2\"]"), "model.x", x_names);
+  if (x_names.empty()) r.fail(model.source(), "model.x", "no states (expected at least one)");
+  if (const toml::node* n = model.get("u")) add_names(*n, "model.u", u_names);
+  if (const toml::node* n = model.get("p")) {
+    const toml::table* pt = n->as_table();
+    if (pt == nullptr)
+      r.wrong_type(*n, "model.p", "a table of name = value, e.g. { omega = 6.28 }");
+    for (const auto& [k, v] : in_file_order(*pt)) {
+      if (!is_identifier(k->str()) || k->str() == "t" || !seen.insert(std::string(k->str())).second)
+        r.fail(v->source(), join("model.p", k->str()), "not a valid, unused name");
+      p_names.emplace_back(k->str());
+      p_values.push_back(r.number(*v, join("model.p", k->str())));
+    }
+  }
+  // Symbols [x, t (unused slot), u, p] as ExpressionLayout expects.
+  std::vector<std::string> symbols = x_names;
+  symbols.push_back("t");
+  symbols.insert(symbols.end(), u_names.begin(), u_names.end());
+  symbols.insert(symbols.end(), p_names.begin(), p_names.end());
+  const int n_x = static_cast<int>(x_names.size()), time_slot = n_x;
+  auto expressions = [&](const toml::node& n, std::string_view path, int length,
+                         std::string_view what) {
+    const toml::array& a = r.array(n, path, "an array of expressions");
+    if (length >= 0 && static_cast<int>(a.size()) != length)
+      r.fail(n.source(), path,
+             fmt::format("wrong length (expected {}, {}, got {})", length, what, a.size()));
+    if (a.empty()) r.fail(n.source(), path, fmt::format("empty (expected {})", what));
+    std::vector<expr::Expression> out;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      out.push_back(r.expression(a[i], index(path, i), symbols));
+      if (out.back().depends_on(time_slot))
+        r.fail(a[i].source(), index(path, i),
+               "uses the time t, which projected models do not support yet");
+    }
+    return out;
+  };
+  std::vector<expr::Expression> f =
+      expressions(required("f", "the vector field, one expression per state"), "model.f", n_x,
+                  "one expression per state in x");
+  std::vector<expr::Expression> c =
+      expressions(required("constraints", "the constraints c(x) >= 0 that define C"),
+                  "model.constraints", -1, "at least one constraint c(x) >= 0");
+  problem.x0 = r.vector(required("x0", "the initial state"), "model.x0", n_x, "one per state in x");
+  ExpressionLayout layout{.n_x = n_x,
+                          .n_x_slots = n_x + 1,
+                          .n_u = static_cast<int>(u_names.size()),
+                          .n_p = static_cast<int>(p_names.size())};
+  const int n_c = static_cast<int>(c.size());  // (c is moved in the call below)
+  try {
+    problem.model =
+        make_expression_pds(PdsDims{.n_x = n_x, .n_u = layout.n_u, .n_p = layout.n_p, .n_c = n_c},
+                            layout, std::move(f), std::move(c));
+  } catch (const InvalidModel& e) {
+    throw InvalidModel(fmt::format("{}: {}", r.at(model.source()), e.what()));
+  }
+  problem.model.state_names = x_names;
+  problem.model.control_names = u_names;
+  problem.model.parameter_names = p_names;
+  problem.p = Eigen::Map<const Eigen::VectorXd>(p_values.data(),
+                                                static_cast<Eigen::Index>(p_values.size()));
+  problem.model.p_default = problem.p;
+  if (const toml::node* n = model.get("x0_tol")) {
+    problem.model.x0_tol = r.number(*n, "model.x0_tol");
+    if (problem.model.x0_tol < 0) r.fail(n->source(), "model.x0_tol", "must be >= 0");
+  }
+  problem.u = Eigen::VectorXd::Zero(layout.n_u);
+
+  // ---- [simulation] and the option tables (the keys of simulation files) ----
+  SimulationProblem options_only;  // the registry writes into its fields
+  const registry::OptionTarget target = target_of(options_only);
+  for (registry::Table table : registry::tables(kKind)) {
+    const toml::node* tn = root.get(registry::to_string(table));
+    if (tn == nullptr) {
+      if (table == registry::Table::Simulation) fail_missing_table(r, table);
+      continue;
+    }
+    const toml::table& t = r.table(*tn, registry::to_string(table));
+    if (table == registry::Table::Simulation) {
+      if (const toml::node* un = t.get("u"))
+        problem.u = r.vector(*un, "simulation.u", layout.n_u, "one per control in model.u");
+      if (const toml::node* tol = t.get("tol_sim"))
+        r.fail(tol->source(), "simulation.tol_sim",
+               "not supported for projected models yet (give N_sim)");
+      if (const toml::node* t0 = t.get("t0"))
+        r.fail(t0->source(), "simulation.t0", "not supported for projected models yet");
+    }
+    check_table_keys(r, t, table, kKind);
+    read_option_table(r, t, table, kKind, target, options_only.options.nlp.extra);
+    check_required_key(r, t, table);
+  }
+  problem.options = options_only.options;
+  problem.T_sim = options_only.T_sim;
+  problem.N_sim = options_only.N_sim;
+  std::vector<std::string> errors = registry::validate_simulation(problem.T_sim, problem.N_sim);
+  for (std::string& e : validate(problem.options)) errors.push_back(std::move(e));
+  if (!errors.empty()) throw_validation_errors(r, root, errors);
+  if (problem.N_sim < 1)
+    r.fail(root.source(), "simulation.N_sim",
+           "required for projected models (>= 1; tol_sim is not supported for them yet)");
+  return problem;
+}
+
+PdsSimulationProblem load_pds_simulation_problem(const std::string& path) {
+  return parse_pds_simulation_problem(read_problem_text(path), path);
+}
+
+IntegratorResult simulate(const PdsSimulationProblem& q) {
+  return integrate(q.model, q.x0, q.T_sim, q.N_sim, q.options, q.u, q.p, q.pds);
+}
+
+}  // namespace fesd

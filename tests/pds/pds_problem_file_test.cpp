@@ -1,0 +1,177 @@
+// Problem files of projected dynamical systems ([model] kind = "projected", docs/pds.md).
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "../../bench/pds_example1_model.hpp"
+#include "fesd/error.hpp"
+#include "fesd/pds_problem_file.hpp"
+#include "fesd/problem_file.hpp"
+#include "support/temp_dir.hpp"
+
+namespace {
+
+const std::string kExample1 = R"(
+name = "ex1"
+[model]
+kind = "projected"
+x = ["x1", "x2"]
+p = { a = 1.0 }
+f = ["x2", "-x1"]
+constraints = ["x2 + a"]
+x0 = [1.4142135623730951, 1.4142135623730951]
+[simulation]
+T_sim = 4.611844073359521
+N_sim = 1
+[discretization]
+n_s = 3
+N_finite_elements = 20
+)";
+
+std::string replace(std::string s, const std::string& from, const std::string& to) {
+  const std::size_t at = s.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) s.replace(at, from.size(), to);
+  return s;
+}
+
+template <class E>
+std::string error_of(const std::string& text) {
+  try {
+    const fesd::PdsSimulationProblem q = fesd::parse_pds_simulation_problem(text, "f.toml");
+    fesd::simulate(q);
+  } catch (const E& e) {
+    return e.what();
+  }
+  return "(no exception)";
+}
+
+// Measured: 1.9e-7 (the C++ model gives the same, tests/pds/pds_example1_test.cpp).
+TEST(PdsProblemFile, Example1) {
+  const fesd::PdsSimulationProblem q = fesd::parse_pds_simulation_problem(kExample1, "f.toml");
+  EXPECT_EQ(q.name, "ex1");
+  EXPECT_EQ(q.model.n_c(), 1);
+  EXPECT_EQ(q.options.discretization.N_FE, 20);
+  const fesd::IntegratorResult r = fesd::simulate(q);
+  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+  EXPECT_LT((r.x_final() - pds_example1::x_T()).norm(), 6e-7);
+  ASSERT_EQ(r.switches.size(), 2u);
+  EXPECT_NEAR(r.switches[0].t, pds_example1::kContact, 8e-7);
+  EXPECT_NEAR(r.switches[1].t, pds_example1::kLeave, 8e-7);
+}
+
+TEST(PdsProblemFile, MixingTheKindsRejected) {
+  const std::string m = error_of<fesd::ProblemFileError>(
+      replace(kExample1, "constraints = [\"x2 + a\"]", "constraints = [\"x2 + a\"]\nc = [\"x1\"]"));
+  EXPECT_NE(m.find("f.toml:"), std::string::npos) << m;
+  EXPECT_NE(m.find("model.c"), std::string::npos) << m;
+  EXPECT_NE(m.find("cannot be mixed"), std::string::npos) << m;
+}
+
+TEST(PdsProblemFile, BadInputOneLineEach) {
+  EXPECT_NE(error_of<fesd::ProblemFileError>(replace(kExample1, "f = [", "fx = ["))
+                .find("unknown key 'fx'"),
+            std::string::npos);
+  EXPECT_NE(
+      error_of<fesd::ProblemFileError>(replace(kExample1, "f = [\"x2\", \"-x1\"]", "f = [\"x2\"]"))
+          .find("model.f: wrong length"),
+      std::string::npos);
+  EXPECT_NE(error_of<fesd::Error>(replace(kExample1, "N_sim = 1\n", "")).find("N_sim"),
+            std::string::npos);
+  EXPECT_NE(error_of<fesd::ProblemFileError>(
+                replace(kExample1, "x0 = [1.4142135623730951, ", "x0 = [nan, "))
+                .find("must be finite"),
+            std::string::npos);
+  EXPECT_NE(error_of<fesd::ProblemFileError>(
+                replace(kExample1, "constraints = [\"x2 + a\"]", "constraints = []"))
+                .find("model.constraints: empty"),
+            std::string::npos);
+  EXPECT_NE(
+      error_of<fesd::ExpressionError>(replace(kExample1, "\"x2 + a\"", "\"x2 + b\"")).find("b"),
+      std::string::npos);
+  // x0 outside C: the integrator's check, one line.
+  const std::string outside = error_of<fesd::InvalidModel>(
+      replace(kExample1, "x0 = [1.4142135623730951, 1.4142135623730951]", "x0 = [0.0, -2.0]"));
+  EXPECT_NE(outside.find("x0 lies outside C"), std::string::npos) << outside;
+  EXPECT_EQ(outside.find('\n'), std::string::npos) << outside;
+  EXPECT_NE(error_of<fesd::InvalidOption>(replace(kExample1, "n_s = 3",
+                                                  "n_s = 3\nrk_scheme = "
+                                                  "\"gauss_legendre\""))
+                .find("radau_iia"),
+            std::string::npos);
+}
+
+}  // namespace
+
+namespace {
+
+using fesd::testing::TempDir;
+
+struct CliRun {
+  int code = -1;
+  std::string out, err;
+};
+
+std::string slurp(const std::string& path) {
+  std::ifstream f(path);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+CliRun fesd_cli(const std::string& args) {
+  TempDir dir;
+  const std::string cmd = std::string("'") + FESD_CLI + "' simulate " + args + " >'" +
+                          dir.file("out") + "' 2>'" + dir.file("err") + "' </dev/null";
+  const int status = std::system(cmd.c_str());
+  return {status != -1 && WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(dir.file("out")),
+          slurp(dir.file("err"))};
+}
+
+// `fesd simulate examples/pds_example1.toml` end to end: the report, and the CSV of t and x.
+TEST(PdsCli, SimulateExample1) {
+  TempDir dir;
+  const CliRun r = fesd_cli(std::string(FESD_SOURCE_DIR) + "/examples/pds_example1.toml --csv '" +
+                            dir.file("x.csv") + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("projected dynamical system, n_x = 2, n_c = 1"), std::string::npos);
+  EXPECT_NE(r.out.find("switches             2"), std::string::npos) << r.out;
+  const std::string csv = slurp(dir.file("x.csv"));
+  EXPECT_EQ(csv.rfind("t,x1,x2\n0,1.4142135623730951,1.4142135623730951\n", 0), 0u) << csv;
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 22);  // header + 21 element boundaries
+}
+
+TEST(PdsCli, UnsupportedOutputsAndOverridesExitTwo) {
+  const std::string file = std::string(FESD_SOURCE_DIR) + "/examples/pds_example1.toml";
+  for (const std::string& extra : {std::string("--json /tmp/x.json"), std::string("--n_s 2")}) {
+    const CliRun r = fesd_cli(file + " " + extra);
+    EXPECT_EQ(r.code, 2) << extra;
+    EXPECT_NE(r.err.find("not supported for projected models"), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
+}
+
+}  // namespace
+
+namespace {
+
+// A projected file given to the piecewise smooth loader (`fesd check`): says what it is.
+TEST(PdsProblemFile, PiecewiseSmoothLoaderNamesTheKind) {
+  try {
+    fesd::parse_simulation_problem(kExample1, "f.toml");
+    FAIL() << "no exception";
+  } catch (const fesd::ProblemFileError& e) {
+    EXPECT_NE(std::string(e.what()).find("model.kind: a projected dynamical system"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+}  // namespace
