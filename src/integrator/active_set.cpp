@@ -225,7 +225,7 @@ bool ActiveSetStep::solve_fixed(const Eigen::VectorXd& x0, const Sets& active,
                                 const discretization::IntervalInputs& other_in,
                                 const std::vector<double>& w_other, std::string& why) {
   const discretization::FesdInterval& iv = *iv_;
-  iterations_ = tries_ = 0;
+  iterations_ = tries_ = factorizations_ = 0;
   fix(nlp_, in_.s0, x0);
   w_ = nlp_.x_init;
   copy_interval(model_, other, w_other, iv, w_);
