@@ -362,12 +362,10 @@ bool ActiveSetStep::factor() {
   double* J = J_.data();
   for (const auto& [e, pos] : jac_map_) J[pos] = 0;
   for (const auto& [e, pos] : jac_map_) J[pos] += jac_[e];
-  lu_.compute(J_);
   ++factorizations_;
-  // A singular Jacobian (not square in effect): the smallest pivot of the LU against the
-  // largest. Cheaper than rcond(), whose estimate costs more than the factorization here.
-  const auto pivots = lu_.matrixLU().diagonal().cwiseAbs();
-  lu_current_ = pivots.minCoeff() > 1e-14 * pivots.maxCoeff();
+  // A singular Jacobian (not square in effect): the smallest pivot of the LU against the largest
+  // (SparseLu::factor).
+  lu_current_ = lu_.factor(J);
   return lu_current_;
 }
 
@@ -393,7 +391,8 @@ ActiveSetTry ActiveSetStep::iterate(bool reuse) {
       return out;
     }
     if (full && !factor()) return out;
-    dz_ = lu_.solve(-F_);
+    dz_ = -F_;
+    lu_.solve(dz_.data());
     ++out.iterations;
     ++iterations_;
     if (!dz_.allFinite()) return out;
@@ -501,10 +500,18 @@ void ActiveSetStep::restrict_to(const Sets& active, const std::vector<nlp::Bound
   for (std::size_t e = 0; e < jac_.size(); ++e)
     if (const int c = col_of_[cols[e]]; c >= 0)
       jac_map_.emplace_back(static_cast<int>(e), rows[e] + n_free * c);
+  std::vector<int> pattern;
+  pattern.reserve(jac_map_.size() + 2 * equal_.size());
+  for (const auto& [e, pos] : jac_map_) pattern.push_back(pos);
   for (std::size_t e = 0; e < equal_.size(); ++e) {
-    J_(m + static_cast<int>(e), col_of_[iv.h(equal_[e])]) = 1;
-    J_(m + static_cast<int>(e), col_of_[iv.h(equal_[e] - 1)]) = -1;
+    const int row = m + static_cast<int>(e);
+    for (const auto& [col, value] : {std::pair{col_of_[iv.h(equal_[e])], 1.0},
+                                     std::pair{col_of_[iv.h(equal_[e] - 1)], -1.0}}) {
+      J_(row, col) = value;
+      pattern.push_back(row + n_free * col);
+    }
   }
+  lu_.analyze(n_free, std::move(pattern));
 }
 
 ActiveSetStep::Violation ActiveSetStep::check_signs(const Sets& active) const {

@@ -33,6 +33,7 @@
 #include "fesd/options.hpp"
 #include "fesd/tableau.hpp"
 #include "integrator/sensitivity.hpp"
+#include "integrator/sparse_lu.hpp"
 #include "nlp/block_nlp.hpp"
 
 namespace fesd::integrator {
@@ -181,8 +182,8 @@ class ActiveSetStep {
   std::vector<std::pair<int, int>> jac_map_;  // (Jacobian entry, index into J_'s storage)
   std::vector<double> lb_, ub_;
   Eigen::MatrixXd J_;
-  Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
-  bool lu_current_ = false;       // lu_ factors a Jacobian of the current shape
+  SparseLu lu_;              // KLU on J_'s nonzeros, the pattern analysed per shape (restrict_to)
+  bool lu_current_ = false;  // lu_ factors a Jacobian of the current shape
   bool chord_converged_ = false;  // the last newton() converged with the LU of a step before
   std::vector<double> w_start_;   // newton()'s start, for the restart with fresh Jacobians
   Eigen::VectorXd F_, dz_;
