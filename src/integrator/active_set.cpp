@@ -1,6 +1,7 @@
 // The active-set step of the integrator: Newton's method on the square system of Thm 15
 // (active_set.hpp, docs/active-set.md).
 #include "integrator/active_set.hpp"
+#include "core/util.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -14,11 +15,7 @@
 namespace fesd::integrator {
 namespace {
 
-std::vector<int> range_of(int first, int n) {
-  std::vector<int> v(n);
-  std::iota(v.begin(), v.end(), first);
-  return v;
-}
+using util::range_of;
 
 void fix(nlp::BlockNlp& nlp, const std::vector<int>& vars, const Eigen::VectorXd& values) {
   for (std::size_t i = 0; i < vars.size(); ++i) {

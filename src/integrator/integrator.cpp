@@ -1,6 +1,7 @@
 // The FESD integrator: one FesdInterval NLP, built once and re-solved for every step with the new
 // start state (fixed variables) and a shifted initial guess.
 #include "fesd/integrator.hpp"
+#include "core/util.hpp"
 
 #include <algorithm>
 #include <array>
@@ -28,23 +29,11 @@
 namespace fesd {
 namespace {
 
+using util::check_finite;
+using util::gather;
+using util::seconds_since;
+
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
-void check_finite(const Eigen::VectorXd& v, const char* name) {
-  for (Eigen::Index i = 0; i < v.size(); ++i)
-    if (!std::isfinite(v[i]))
-      throw InvalidModel(fmt::format("{}[{}] = {}: must be finite", name, i, v[i]));
-}
-
-Eigen::VectorXd gather(const std::vector<double>& w, int first, int n) {
-  Eigen::VectorXd v(n);
-  for (int i = 0; i < n; ++i) v[i] = w[first + i];
-  return v;
-}
-
 /// Appends the N_FE elements of a step (NLP point w) to the result; advances t.
 void append_step(IntegratorResult& res, const Pss& model, const discretization::FesdInterval& iv,
                  const Tableau& tab, const std::vector<double>& w, double& t) {

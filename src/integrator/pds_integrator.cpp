@@ -8,6 +8,7 @@
 #include <fmt/ranges.h>
 
 #include "core/option_registry.hpp"
+#include "core/util.hpp"
 #include "discretization/pds_interval.hpp"
 #include "fesd/error.hpp"
 #include "fesd/pds.hpp"
@@ -17,29 +18,12 @@
 namespace fesd {
 namespace {
 
+using util::check_finite;
+using util::gather;
+using util::range_of;
+using util::seconds_since;
+
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
-void check_finite(const Eigen::VectorXd& v, const char* name) {
-  for (Eigen::Index i = 0; i < v.size(); ++i)
-    if (!std::isfinite(v[i]))
-      throw InvalidModel(fmt::format("{}[{}] = {}: must be finite", name, i, v[i]));
-}
-
-std::vector<int> range_of(int first, int n) {
-  std::vector<int> v(static_cast<std::size_t>(n));
-  for (int i = 0; i < n; ++i) v[i] = first + i;
-  return v;
-}
-
-Eigen::VectorXd gather(const std::vector<double>& w, int first, int n) {
-  Eigen::VectorXd v(n);
-  for (int i = 0; i < n; ++i) v[i] = w[first + i];
-  return v;
-}
-
 /// grad c_k(x) (n_x) of one constraint.
 Eigen::VectorXd grad_c(const Pds& m, const Eigen::VectorXd& x, const Eigen::VectorXd& p, int k) {
   Eigen::VectorXd e = Eigen::VectorXd::Zero(m.n_c()), g(m.n_x());

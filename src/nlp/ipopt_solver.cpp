@@ -2,6 +2,7 @@
 // Exceptions never cross IPOPT: evaluations return false on non-finite values and IPOPT cuts the
 // step; the status comes back in NlpResult.
 #include "nlp/ipopt_solver.hpp"
+#include "core/util.hpp"
 
 #include <dlfcn.h>
 
@@ -23,11 +24,9 @@
 namespace fesd::nlp {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
+using util::seconds_since;
 
+using Clock = std::chrono::steady_clock;
 std::string status_name(Ipopt::ApplicationReturnStatus s) {
   switch (s) {
     case Ipopt::Solve_Succeeded:

@@ -2,6 +2,7 @@
 // s_k (multiple-shooting type, Sect. 5.1), one FesdInterval per interval, costs and constraints as
 // blocks, the MPCC solved by a homotopy (Sect. 5.2).
 #include "fesd/ocp.hpp"
+#include "core/util.hpp"
 
 #include <chrono>
 #include <cmath>
@@ -31,25 +32,18 @@
 namespace fesd {
 namespace {
 
+using util::gather;
+using util::seconds_since;
+
 using Clock = std::chrono::steady_clock;
 using discretization::FesdInterval;
 using discretization::IntervalInputs;
 using nlp::kInf;
 
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
 std::vector<int> range(int first, int n) {
   std::vector<int> r(n);
   for (int i = 0; i < n; ++i) r[i] = first + i;
   return r;
-}
-
-Eigen::VectorXd gather(const std::vector<double>& w, int first, int n) {
-  Eigen::VectorXd v(n);
-  for (int i = 0; i < n; ++i) v[i] = w[first + i];
-  return v;
 }
 
 // ---- cost and constraint blocks ----------------------------------------------------------------
