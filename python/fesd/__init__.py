@@ -231,6 +231,17 @@ class _Result:
         """Several lines: as the fesd program prints after a run (switches, work, timing)."""
         return self.__dict__["_full_report"]
 
+    def plot(self, path=None, title=None):
+        """Draws the result with matplotlib (python3-matplotlib); returns the Figure.
+
+        What the fesd program's --plot draws: the states over t with the switches as dashed
+        lines labelled with the regions before and after ("{0}->{1}") and sliding shaded, the
+        step sizes h_n, for an OCP the controls and eta_n; a phase portrait for two states.
+        ``path``: also saved there (PNG, SVG, PDF by its suffix). See fesd.plot.plot.
+        """
+        from .plot import plot
+        return plot(self, path, title)
+
     @property
     def success(self):
         """True if status is "success"."""
@@ -253,7 +264,8 @@ class SimulationResult(_Result):
     Attributes (numpy arrays unless said otherwise; N elements, n_s stages each):
       status (str): "success", "complementarity_not_met", "nlp_failed", "evaluation_failed",
           "tolerance_not_met"; message (str): one sentence about it; success (bool).
-      name (str), state_names (list of str).
+      name (str), state_names (list of str), region_subsystem (list: the subsystem of each
+          region).
       t (N+1,): element boundaries; x (N+1, n_x): states there; h (N,): element lengths;
       x_final (n_x,): x(T).
       t_stage (N n_s,), x_stage (N n_s, n_x), theta, lambda_ (N n_s, n_regions), mu (N n_s,
@@ -270,7 +282,7 @@ class SimulationResult(_Result):
           warnings).
       accuracy (dict): error_estimate of x(T), switch_time_estimate, order, tol_sim, met,
           N_sim, note, runs (one dict per integration made).
-    Methods: brief_report(), full_report().
+    Methods: brief_report(), full_report(), plot().
     """
 
     __init__ = _result_init
@@ -290,7 +302,7 @@ class OcpResult(_Result):
       eta (M,): eta of eq. (31) at each element's start (NaN at interval starts), 0 at a switch.
       t_stage, x_stage, theta, lambda_: stage points and values.
       homotopy (list of dict): one row per NLP solved; summary (dict): work and time.
-    Methods: brief_report(), full_report().
+    Methods: brief_report(), full_report(), plot().
     """
 
     __init__ = _result_init

@@ -212,12 +212,24 @@ std::vector<std::string> control_names(const fesd::Pss& model) {
   return names;
 }
 
+/// The subsystem of every region (region r belongs to subsystem k if region_offset(k) <= r <
+/// region_offset(k + 1)): a subsystem with two or more active regions slides.
+std::vector<int> region_subsystem(const fesd::Pss& model) {
+  std::vector<int> out(static_cast<std::size_t>(model.n_theta()), 0);
+  for (int k = 0; k < model.n_sys(); ++k) {
+    const int end = k + 1 < model.n_sys() ? model.region_offset(k + 1) : model.n_theta();
+    for (int r = model.region_offset(k); r < end; ++r) out[static_cast<std::size_t>(r)] = k;
+  }
+  return out;
+}
+
 py::dict simulation_dict(const fesd::SimulationProblem& problem, const fesd::IntegratorResult& r) {
   const fesd::Pss& m = problem.model;
   py::dict d;
   d["kind"] = "simulation";
   d["name"] = problem.name;
   d["state_names"] = state_names(m);
+  d["region_subsystem"] = region_subsystem(m);
   d["status"] = std::string(fesd::to_string(r.status));
   d["message"] = r.message;
   d["t"] = vector_array(r.t);
@@ -249,6 +261,7 @@ py::dict ocp_dict(const fesd::OcpProblem& problem, const fesd::OcpResult& r) {
   d["name"] = problem.name;
   d["state_names"] = state_names(m);
   d["control_names"] = control_names(m);
+  d["region_subsystem"] = region_subsystem(m);
   d["status"] = std::string(fesd::to_string(r.status));
   d["message"] = r.message;
   d["objective"] = r.objective;
