@@ -3,7 +3,8 @@
 set -euo pipefail
 pkgs=(build-essential cmake pkg-config coinor-libipopt-dev libeigen3-dev libtomlplusplus-dev
       nlohmann-json3-dev libcli11-dev libfmt-dev libgtest-dev liblapack-dev libsuitesparse-dev gnuplot-nox
-      python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib)
+      python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib
+      python3-dask python3-distributed)
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
