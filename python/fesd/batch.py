@@ -5,8 +5,8 @@
     >>> results = fesd.batch.map("examples/ocp_sensitivity.toml", overrides=guesses)
     >>> [r.x0[0] for r in results]
 
-The problem is read once here (bad input raises fesd.InputError before anything is sent) and its
-text goes to the workers with each case's overrides, so the workers need fesd but not the file.
+The problem is read once here (bad input raises fesd.InputError before anything is sent); a
+fesd.Problem pickles as its text and overrides, so the workers need fesd but not the file.
 """
 
 import os
@@ -14,7 +14,7 @@ import shutil
 import sys
 import tempfile
 
-from . import _fesd, load, simulate, solve, to_toml, InputError
+from . import load, simulate, solve, InputError
 
 
 class CaseError:
@@ -44,32 +44,15 @@ class CaseError:
         return f"<fesd.batch.CaseError {self.brief_report()}>"
 
 
-def _run_case(text, source, is_ocp, overrides):
-    """One case on a worker: read the problem from its text, apply the overrides, run it."""
+def _run_case(problem, overrides):
+    """One case on a worker: the problem (unpickled: read again from its text), with overrides."""
     try:
-        problem = _fesd._parse(text, source, is_ocp)
-        run = solve if is_ocp else simulate
+        run = solve if problem.kind == "ocp" else simulate
         return run(problem, options=overrides)
     except InputError as e:
         return CaseError("input_error", str(e), "InputError", overrides)
     except Exception as e:  # noqa: BLE001 - one failing case never stops the others
         return CaseError("error", str(e), type(e).__name__, overrides)
-
-
-def _problem_text(problem):
-    """(TOML text, source name, is_ocp) of a path or a dict, checked here."""
-    if isinstance(problem, dict):
-        return to_toml(problem), "<dict>", load(problem).kind == "ocp"
-    if isinstance(problem, (str, os.PathLike)):
-        source = os.fspath(problem)
-        is_ocp = load(source).kind == "ocp"  # bad input raises here, not on the workers
-        try:
-            with open(source, encoding="utf-8") as f:
-                return f.read(), source, is_ocp
-        except OSError as e:
-            raise InputError(f"{source}: cannot be read: {e.strerror}") from None
-    raise InputError("fesd.batch.map: the problem must be a file path or a dict (a fesd.Problem "
-                     f"cannot be sent to workers; got {type(problem).__name__})")
 
 
 def _progress(done, total, out):
@@ -84,7 +67,8 @@ def _progress(done, total, out):
 def map(problem, overrides, client=None, progress=True, n_workers=None):  # noqa: A001
     """Runs one simulation (or OCP solve) per entry of ``overrides``, in parallel on Dask.
 
-    ``problem``: a problem file's path or a dict (fesd.load); it is read and checked here.
+    ``problem``: a fesd.Problem, a problem file's path or a dict (fesd.load); it is read and
+    checked here.
     ``overrides``: a list of dicts, one per case, each as the keyword arguments of
     fesd.simulate / fesd.solve (``{"n_s": 3, "x0": [0.5]}``; dotted keys allowed).
     ``client``: None for a local cluster started for this call (``n_workers`` processes, default
@@ -104,7 +88,7 @@ def map(problem, overrides, client=None, progress=True, n_workers=None):  # noqa
         raise ImportError("fesd.batch needs Dask's distributed scheduler (Debian: "
                           "python3-dask python3-distributed)") from e
     cases = [dict(o) for o in overrides]
-    text, source, is_ocp = _problem_text(problem)
+    problem = load(problem)  # bad input raises here, before any worker starts
 
     scratch = None
     cluster = None
@@ -118,8 +102,7 @@ def map(problem, overrides, client=None, progress=True, n_workers=None):  # noqa
             client = own_client = Client(cluster)
         elif isinstance(client, str):
             client = own_client = Client(client)
-        futures = [client.submit(_run_case, text, source, is_ocp, case, pure=False)
-                   for case in cases]
+        futures = [client.submit(_run_case, problem, case, pure=False) for case in cases]
         out = sys.stderr
         if progress:
             _progress(0, len(futures), out)

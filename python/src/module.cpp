@@ -6,7 +6,10 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <fstream>
+#include <sstream>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <variant>
 #include <vector>
@@ -22,9 +25,15 @@ namespace py = pybind11;
 
 namespace {
 
-/// A problem file's content: a simulation or an optimal control problem.
+using Overrides = std::vector<std::pair<std::string, std::string>>;
+
+/// A problem file's content: a simulation or an optimal control problem, with the text it was
+/// read from and the overrides applied since, so that it pickles (read again from both).
 struct Problem {
   std::variant<fesd::SimulationProblem, fesd::OcpProblem> value;
+  std::string text;         ///< the TOML text (empty: the file could not be read again)
+  std::string source_name;  ///< the file or the name given for a dict
+  Overrides overrides;      ///< applied in this order after reading
 
   bool is_ocp() const { return std::holds_alternative<fesd::OcpProblem>(value); }
   const fesd::Pss& model() const {
@@ -36,8 +45,6 @@ struct Problem {
     return std::visit(std::forward<F>(f), value);
   }
 };
-
-using Overrides = std::vector<std::pair<std::string, std::string>>;
 
 /// Applies (key, value) overrides as the CLI does: apply_override re-validates after every key, so
 /// keys that fail are retried as long as others succeed; the first remaining failure is thrown.
@@ -291,20 +298,47 @@ py::dict ocp_dict(const fesd::OcpProblem& problem, const fesd::OcpResult& r) {
 }
 
 Problem load(const std::string& path) {
+  Problem problem;
   if (fesd::problem_file_kind(path) == fesd::ProblemKind::Ocp)
-    return Problem{fesd::load_ocp_problem(path)};
-  return Problem{fesd::load_simulation_problem(path)};
+    problem.value = fesd::load_ocp_problem(path);
+  else
+    problem.value = fesd::load_simulation_problem(path);
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in) problem.text = text.str();
+  problem.source_name = path;
+  return problem;
 }
 
 Problem parse(const std::string& text, const std::string& source_name, bool ocp) {
-  if (ocp) return Problem{fesd::parse_ocp_problem(text, source_name)};
-  return Problem{fesd::parse_simulation_problem(text, source_name)};
+  Problem problem;
+  if (ocp)
+    problem.value = fesd::parse_ocp_problem(text, source_name);
+  else
+    problem.value = fesd::parse_simulation_problem(text, source_name);
+  problem.text = text;
+  problem.source_name = source_name;
+  return problem;
 }
 
 Problem with_overrides(const Problem& problem, const Overrides& overrides) {
   Problem copy = problem;
   std::visit([&](auto& p) { apply_overrides(p, overrides); }, copy.value);
+  copy.overrides.insert(copy.overrides.end(), overrides.begin(), overrides.end());
   return copy;
+}
+
+using ProblemState = std::tuple<std::string, std::string, bool, Overrides>;
+
+ProblemState problem_state(const Problem& p) {
+  if (p.text.empty())
+    throw fesd::IoError(p.source_name + ": cannot be read again to pickle the problem");
+  return {p.text, p.source_name, p.is_ocp(), p.overrides};
+}
+
+Problem problem_from_state(const ProblemState& s) {
+  return with_overrides(parse(std::get<0>(s), std::get<1>(s), std::get<2>(s)), std::get<3>(s));
 }
 
 py::dict simulate(const Problem& problem, const Overrides& overrides) {
@@ -407,6 +441,7 @@ PYBIND11_MODULE(_fesd, m) {
       .def_property_readonly(
           "n_regions", [](const Problem& p) { return p.model().n_theta(); },
           "Number of regions (rows of the stacked sign matrices).")
+      .def(py::pickle(&problem_state, &problem_from_state))
       .def("__repr__", [](const Problem& p) {
         return p.visit([&](const auto& q) {
           return "<fesd.Problem " + std::string(p.is_ocp() ? "ocp" : "simulation") + " '" + q.name +

@@ -1,7 +1,6 @@
 # fesd.batch.map on a 2-worker local Dask cluster (skipped without python3-distributed): results
 # in order, the same numbers as serial runs, a failing case does not stop the others, nothing is
 # written into the working directory, Dask's scratch space is removed.
-import glob
 import os
 import tempfile
 
@@ -15,8 +14,11 @@ import fesd.batch  # noqa: E402
 
 
 def test_a_sweep_on_a_local_cluster(examples, tmp_path, monkeypatch, capsys):
-    monkeypatch.chdir(tmp_path)
-    scratch_before = set(glob.glob(os.path.join(tempfile.gettempdir(), "fesd-dask-*")))
+    work, temp = tmp_path / "work", tmp_path / "temp"
+    work.mkdir()
+    temp.mkdir()
+    monkeypatch.chdir(work)
+    monkeypatch.setattr(tempfile, "tempdir", str(temp))  # where Dask's scratch space goes
     cases = [{"n_s": 1}, {"n_s": 2}, {"n_s": 0}, {"n_s": 3, "N_sim": 40},
              {"x0": [0.5, 0.0], "error_estimate": False}]
     path = examples / "oscillator.toml"
@@ -35,8 +37,8 @@ def test_a_sweep_on_a_local_cluster(examples, tmp_path, monkeypatch, capsys):
         np.testing.assert_array_equal(r.switch_times, serial.switch_times)
     assert results[3].x.shape == (81, 2)
     assert "5/5" in capsys.readouterr().err  # the progress bar
-    assert os.listdir(tmp_path) == []
-    assert set(glob.glob(os.path.join(tempfile.gettempdir(), "fesd-dask-*"))) == scratch_before
+    assert os.listdir(work) == []
+    assert os.listdir(temp) == []  # the scratch space was there and is removed
 
 
 def test_ocp_sweep_and_bad_input(examples):
@@ -55,5 +57,8 @@ def test_ocp_sweep_and_bad_input(examples):
         assert r.status == "success" and abs(r.x0[0] - x0_star) < 1e-6
     with pytest.raises(fesd.InputError, match="unknown key"):  # checked before any worker starts
         fesd.batch.map({"model": {"xx": 1}}, [{}])
-    with pytest.raises(fesd.InputError, match="file path or a dict"):
-        fesd.batch.map(fesd.load(examples / "oscillator.toml"), [{}])
+    # a Problem with overrides travels as its text and overrides
+    p = fesd.with_options(examples / "oscillator.toml", n_s=2, N_sim=10, error_estimate=False)
+    [r] = fesd.batch.map(p, [{}], n_workers=1, progress=False)
+    np.testing.assert_array_equal(r.x, fesd.simulate(p).x)
+    assert r.t_stage.shape == (40,)  # 10 steps x 2 elements x 2 stages

@@ -114,3 +114,12 @@ def test_results_pickle(examples):
     np.testing.assert_array_equal(r2.lambda_, r.lambda_)
     assert r2.switches == r.switches and r2.summary == r.summary
     assert r2.brief_report() == r.brief_report() and r2.full_report() == r.full_report()
+
+
+def test_problems_pickle(examples):
+    p = fesd.with_options(examples / "oscillator.toml", n_s=2, p={"omega": 3.0})
+    q = pickle.loads(pickle.dumps(p))
+    assert q.name == "oscillator" and q.parameters == {"omega": 3.0}
+    np.testing.assert_array_equal(fesd.simulate(q, N_sim=10).x, fesd.simulate(p, N_sim=10).x)
+    d = pickle.loads(pickle.dumps(fesd.load(example3(), name="ex3")))
+    assert d.name == "example3" and d.source == "ex3"
