@@ -1,0 +1,462 @@
+// python/src/module.cpp: the extension module fesd._fesd (pybind11). It holds problems as read by
+// the problem-file loaders and runs fesd::simulate / fesd::solve without the GIL; results come
+// back as plain Python data (dicts of numpy arrays, lists, strings), which the pure Python layer
+// (python/fesd/__init__.py) wraps into picklable result objects. docs/python.md.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <tuple>
+#include <utility>
+#include <variant>
+#include <vector>
+
+#include "fesd/error.hpp"
+#include "fesd/integrator.hpp"
+#include "fesd/ocp.hpp"
+#include "fesd/problem_file.hpp"
+#include "fesd/status.hpp"
+#include "fesd/summary.hpp"
+
+namespace py = pybind11;
+
+namespace {
+
+using Overrides = std::vector<std::pair<std::string, std::string>>;
+
+/// A problem file's content: a simulation or an optimal control problem, with the text it was
+/// read from and the overrides applied since, so that it pickles (read again from both).
+struct Problem {
+  std::variant<fesd::SimulationProblem, fesd::OcpProblem> value;
+  std::string text;         ///< the TOML text (empty: the file could not be read again)
+  std::string source_name;  ///< the file or the name given for a dict
+  Overrides overrides;      ///< applied in this order after reading
+
+  bool is_ocp() const { return std::holds_alternative<fesd::OcpProblem>(value); }
+  const fesd::Pss& model() const {
+    return is_ocp() ? std::get<fesd::OcpProblem>(value).ocp.model
+                    : std::get<fesd::SimulationProblem>(value).model;
+  }
+  template <class F>
+  decltype(auto) visit(F&& f) const {
+    return std::visit(std::forward<F>(f), value);
+  }
+};
+
+/// Applies (key, value) overrides as the CLI does: apply_override re-validates after every key, so
+/// keys that fail are retried as long as others succeed; the first remaining failure is thrown.
+template <class P>
+void apply_overrides(P& problem, Overrides pending) {
+  while (!pending.empty()) {
+    Overrides failed;
+    std::string first_error;
+    for (const auto& [key, value] : pending) {
+      try {
+        fesd::apply_override(problem, key, value);
+      } catch (const fesd::InvalidOption& e) {
+        if (failed.empty()) first_error = e.what();
+        failed.emplace_back(key, value);
+      }
+    }
+    if (failed.size() == pending.size()) throw fesd::InvalidOption(first_error);
+    pending = std::move(failed);
+  }
+}
+
+py::array_t<double> vector_array(const std::vector<double>& v) {
+  py::array_t<double> a(static_cast<py::ssize_t>(v.size()));
+  std::copy(v.begin(), v.end(), a.mutable_data());
+  return a;
+}
+
+py::array_t<double> vector_array(const Eigen::VectorXd& v) {
+  py::array_t<double> a(static_cast<py::ssize_t>(v.size()));
+  std::copy(v.data(), v.data() + v.size(), a.mutable_data());
+  return a;
+}
+
+/// Rows of equal length as an (N, n) array; n = `width` when there are no rows.
+py::array_t<double> matrix_array(const std::vector<Eigen::VectorXd>& rows, Eigen::Index width) {
+  const Eigen::Index n = rows.empty() ? width : rows.front().size();
+  py::array_t<double> a({static_cast<py::ssize_t>(rows.size()), static_cast<py::ssize_t>(n)});
+  auto m = a.mutable_unchecked<2>();
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    if (rows[i].size() != n)
+      throw fesd::InternalError("internal: rows of different lengths in a result");
+    for (Eigen::Index j = 0; j < n; ++j)
+      m(static_cast<py::ssize_t>(i), static_cast<py::ssize_t>(j)) = rows[i][j];
+  }
+  return a;
+}
+
+py::dict homotopy_row(const fesd::HomotopyRow& r) {
+  py::dict d;
+  d["k"] = r.k;
+  d["sigma"] = r.sigma;
+  d["comp_residual"] = r.comp_residual;
+  d["objective"] = r.objective;
+  d["inf_pr"] = r.inf_pr;
+  d["nlp_iterations"] = r.nlp_iterations;
+  d["nlp_status"] = r.nlp_status;
+  d["cpu_s"] = r.cpu_s;
+  d["linear_solver"] = r.linear_solver;
+  d["factor_s"] = r.factor_s;
+  d["factorizations"] = r.factorizations;
+  d["active_set_fixed"] = r.active_set_fixed;
+  d["pinned_exits"] = r.pinned_exits;
+  return d;
+}
+
+py::list homotopy_rows(const std::vector<fesd::HomotopyRow>& rows) {
+  py::list l;
+  for (const fesd::HomotopyRow& r : rows) l.append(homotopy_row(r));
+  return l;
+}
+
+py::list switch_events(const std::vector<fesd::SwitchEvent>& switches) {
+  py::list l;
+  for (const fesd::SwitchEvent& s : switches) {
+    py::dict d;
+    d["t"] = s.t;
+    d["element"] = s.element;
+    d["before"] = s.before;
+    d["after"] = s.after;
+    d["located"] = s.located;
+    l.append(d);
+  }
+  return l;
+}
+
+py::array_t<double> switch_times(const std::vector<fesd::SwitchEvent>& switches) {
+  std::vector<double> t;
+  for (const fesd::SwitchEvent& s : switches) t.push_back(s.t);
+  return vector_array(t);
+}
+
+py::dict summary_dict(const fesd::Summary& s) {
+  py::dict d;
+  d["homotopy_steps"] = s.homotopy_steps;
+  d["nlp_iterations"] = s.nlp_iterations;
+  d["wall_s"] = s.wall_s;
+  d["derivative_s"] = s.derivative_s;
+  d["solver_s"] = s.solver_s;
+  d["setup_s"] = s.setup_s;
+  d["max_comp_residual"] = s.max_comp_residual;
+  d["n_variables"] = s.n_variables;
+  d["n_constraints"] = s.n_constraints;
+  d["fallback_steps"] = s.fallback_steps;
+  d["refine_attempts"] = s.refine_attempts;
+  d["refined_steps"] = s.refined_steps;
+  d["split_steps"] = s.split_steps;
+  d["active_set_path_steps"] = s.active_set_path_steps;
+  d["homotopy_path_steps"] = s.homotopy_path_steps;
+  d["newton_iterations"] = s.newton_iterations;
+  d["active_set_tries"] = s.active_set_tries;
+  d["active_set_s"] = s.active_set_s;
+  d["active_set_solves"] = s.active_set_solves;
+  d["active_set_failures"] = s.active_set_failures;
+  d["rescued_steps"] = s.rescued_steps;
+  d["pinned_exits"] = s.pinned_exits;
+  d["pin_failures"] = s.pin_failures;
+  d["grid_moves"] = s.grid_moves;
+  d["born_switches"] = s.born_switches;
+  d["allocation_solves"] = s.allocation_solves;
+  d["allocation_moves"] = s.allocation_moves;
+  d["held_switches"] = s.held_switches;
+  d["warnings"] = s.warnings;
+  return d;
+}
+
+py::dict accuracy_dict(const fesd::Accuracy& a) {
+  py::dict d;
+  d["error_estimate"] = a.error_estimate;
+  d["switch_time_estimate"] = a.switch_time_estimate;
+  d["switch_times_consistent"] = a.switch_times_consistent;
+  d["noise_floor"] = a.noise_floor;
+  d["at_noise_floor"] = a.at_noise_floor;
+  d["consistent"] = a.consistent;
+  d["order"] = a.order;
+  d["tol_sim"] = a.tol_sim;
+  d["met"] = a.met;
+  d["N_sim"] = a.N_sim;
+  d["note"] = a.note;
+  py::list runs;
+  for (const fesd::AccuracyRun& r : a.runs) {
+    py::dict run;
+    run["N_sim"] = r.N_sim;
+    run["status"] = std::string(fesd::to_string(r.status));
+    run["x_final"] = vector_array(r.x_final);
+    run["switch_times"] = vector_array(r.switch_times);
+    run["error_estimate"] = r.error_estimate;
+    run["wall_s"] = r.wall_s;
+    runs.append(run);
+  }
+  d["runs"] = runs;
+  return d;
+}
+
+/// "x3" for ("x", 2): names the model leaves out are numbered from 1 (as in the CLI's outputs).
+std::string numbered(const char* prefix, int i) {
+  std::string name(prefix);
+  name += std::to_string(i + 1);
+  return name;
+}
+
+std::vector<std::string> state_names(const fesd::Pss& model) {
+  std::vector<std::string> names = model.state_names;
+  for (int i = static_cast<int>(names.size()); i < model.n_x(); ++i)
+    names.push_back(numbered("x", i));
+  return names;
+}
+
+std::vector<std::string> control_names(const fesd::Pss& model) {
+  std::vector<std::string> names = model.control_names;
+  for (int i = static_cast<int>(names.size()); i < model.n_u(); ++i)
+    names.push_back(numbered("u", i));
+  return names;
+}
+
+/// The subsystem of every region (region r belongs to subsystem k if region_offset(k) <= r <
+/// region_offset(k + 1)): a subsystem with two or more active regions slides.
+std::vector<int> region_subsystem(const fesd::Pss& model) {
+  std::vector<int> out(static_cast<std::size_t>(model.n_theta()), 0);
+  for (int k = 0; k < model.n_sys(); ++k) {
+    const int end = k + 1 < model.n_sys() ? model.region_offset(k + 1) : model.n_theta();
+    for (int r = model.region_offset(k); r < end; ++r) out[static_cast<std::size_t>(r)] = k;
+  }
+  return out;
+}
+
+py::dict simulation_dict(const fesd::SimulationProblem& problem, const fesd::IntegratorResult& r) {
+  const fesd::Pss& m = problem.model;
+  py::dict d;
+  d["kind"] = "simulation";
+  d["name"] = problem.name;
+  d["state_names"] = state_names(m);
+  d["region_subsystem"] = region_subsystem(m);
+  d["status"] = std::string(fesd::to_string(r.status));
+  d["message"] = r.message;
+  d["t"] = vector_array(r.t);
+  d["x"] = matrix_array(r.x, m.n_x());
+  d["h"] = vector_array(r.h);
+  d["t_stage"] = vector_array(r.t_stage);
+  d["x_stage"] = matrix_array(r.x_stage, m.n_x());
+  d["theta"] = matrix_array(r.theta, m.n_theta());
+  d["lambda_"] = matrix_array(r.lambda, m.n_theta());
+  d["mu"] = matrix_array(r.mu, m.n_sys());
+  d["active_set"] = r.active_set;
+  d["switches"] = switch_events(r.switches);
+  d["switch_times"] = switch_times(r.switches);
+  py::list homotopy;
+  for (const auto& rows : r.homotopy) homotopy.append(homotopy_rows(rows));
+  d["homotopy"] = homotopy;
+  d["summary"] = summary_dict(r.summary);
+  d["accuracy"] = accuracy_dict(r.accuracy);
+  d["x_final"] = vector_array(r.x_final());
+  d["brief_report"] = r.brief_report();
+  d["full_report"] = r.full_report();
+  return d;
+}
+
+py::dict ocp_dict(const fesd::OcpProblem& problem, const fesd::OcpResult& r) {
+  const fesd::Pss& m = problem.ocp.model;
+  py::dict d;
+  d["kind"] = "ocp";
+  d["name"] = problem.name;
+  d["state_names"] = state_names(m);
+  d["control_names"] = control_names(m);
+  d["region_subsystem"] = region_subsystem(m);
+  d["status"] = std::string(fesd::to_string(r.status));
+  d["message"] = r.message;
+  d["objective"] = r.objective;
+  d["comp_residual"] = r.comp_residual;
+  d["mpcc_mode"] = std::string(fesd::to_string(r.mpcc_mode));
+  d["t"] = vector_array(r.t);
+  d["x"] = matrix_array(r.x, m.n_x());
+  d["h"] = vector_array(r.h);
+  d["interval"] = r.interval;
+  d["t_ctrl"] = vector_array(r.t_ctrl);
+  d["u"] = matrix_array(r.u, m.n_u());
+  d["active_set"] = r.active_set;
+  d["switches"] = switch_events(r.switches);
+  d["switch_times"] = switch_times(r.switches);
+  d["eta"] = vector_array(r.eta);
+  d["t_stage"] = vector_array(r.t_stage);
+  d["x_stage"] = matrix_array(r.x_stage, m.n_x());
+  d["theta"] = matrix_array(r.theta, m.n_theta());
+  d["lambda_"] = matrix_array(r.lambda, m.n_theta());
+  d["homotopy"] = homotopy_rows(r.homotopy);
+  d["summary"] = summary_dict(r.summary);
+  d["x0"] = vector_array(r.x0());
+  d["x_final"] = vector_array(r.x_final());
+  d["brief_report"] = r.brief_report();
+  d["full_report"] = r.full_report();
+  return d;
+}
+
+Problem load(const std::string& path) {
+  Problem problem;
+  if (fesd::problem_file_kind(path) == fesd::ProblemKind::Ocp)
+    problem.value = fesd::load_ocp_problem(path);
+  else
+    problem.value = fesd::load_simulation_problem(path);
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in) problem.text = text.str();
+  problem.source_name = path;
+  return problem;
+}
+
+Problem parse(const std::string& text, const std::string& source_name, bool ocp) {
+  Problem problem;
+  if (ocp)
+    problem.value = fesd::parse_ocp_problem(text, source_name);
+  else
+    problem.value = fesd::parse_simulation_problem(text, source_name);
+  problem.text = text;
+  problem.source_name = source_name;
+  return problem;
+}
+
+Problem with_overrides(const Problem& problem, const Overrides& overrides) {
+  Problem copy = problem;
+  std::visit([&](auto& p) { apply_overrides(p, overrides); }, copy.value);
+  copy.overrides.insert(copy.overrides.end(), overrides.begin(), overrides.end());
+  return copy;
+}
+
+using ProblemState = std::tuple<std::string, std::string, bool, Overrides>;
+
+ProblemState problem_state(const Problem& p) {
+  if (p.text.empty())
+    throw fesd::IoError(p.source_name + ": cannot be read again to pickle the problem");
+  return {p.text, p.source_name, p.is_ocp(), p.overrides};
+}
+
+Problem problem_from_state(const ProblemState& s) {
+  return with_overrides(parse(std::get<0>(s), std::get<1>(s), std::get<2>(s)), std::get<3>(s));
+}
+
+py::dict simulate(const Problem& problem, const Overrides& overrides) {
+  if (problem.is_ocp())
+    throw fesd::InvalidOption(
+        "an optimal control problem ([ocp] table): use fesd.solve, not fesd.simulate");
+  fesd::SimulationProblem p = std::get<fesd::SimulationProblem>(problem.value);
+  apply_overrides(p, overrides);
+  fesd::IntegratorResult r;
+  {
+    py::gil_scoped_release release;
+    r = fesd::simulate(p);
+  }
+  return simulation_dict(p, r);
+}
+
+py::dict solve(const Problem& problem, const Overrides& overrides) {
+  if (!problem.is_ocp())
+    throw fesd::InvalidOption(
+        "a simulation problem (no [ocp] table): use fesd.simulate, not fesd.solve");
+  fesd::OcpProblem p = std::get<fesd::OcpProblem>(problem.value);
+  apply_overrides(p, overrides);
+  fesd::OcpResult r;
+  {
+    py::gil_scoped_release release;
+    r = fesd::solve(p.ocp, p.options);
+  }
+  return ocp_dict(p, r);
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_fesd, m) {
+  m.doc() =
+      "The compiled core of the fesd package (pybind11). Use the package `fesd` itself: "
+      "fesd.load, fesd.simulate, fesd.solve (docs/python.md).";
+
+  static py::exception<fesd::Error> input_error(m, "InputError", PyExc_ValueError);
+  input_error.doc() =
+      "Bad input: a malformed problem file or dict, an unknown option or a value out of range. "
+      "The message is the one line the fesd program prints, e.g. \"unknown option 'n_S' (did you "
+      "mean 'n_s'?)\". A ValueError.";
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const fesd::Error& e) {
+      PyErr_SetString(input_error.ptr(), e.what());
+    } catch (const fesd::InternalError& e) {
+      PyErr_SetString(PyExc_RuntimeError, (std::string("internal error: ") + e.what()).c_str());
+    }
+  });
+
+  py::class_<Problem>(m, "Problem",
+                      "A problem as read from a problem file or a dict: a simulation ([simulation] "
+                      "table) or an optimal control problem ([ocp] table). Made by fesd.load; "
+                      "run it with fesd.simulate or fesd.solve.")
+      .def_property_readonly(
+          "kind", [](const Problem& p) { return p.is_ocp() ? "ocp" : "simulation"; },
+          "\"simulation\" or \"ocp\".")
+      .def_property_readonly(
+          "name", [](const Problem& p) { return p.visit([](const auto& q) { return q.name; }); },
+          "The problem's `name`, or the file's stem.")
+      .def_property_readonly(
+          "description",
+          [](const Problem& p) { return p.visit([](const auto& q) { return q.description; }); },
+          "The problem's `description` (may be empty).")
+      .def_property_readonly(
+          "source",
+          [](const Problem& p) { return p.visit([](const auto& q) { return q.source; }); },
+          "The file it was read from (or the name given for a dict).")
+      .def_property_readonly(
+          "state_names", [](const Problem& p) { return state_names(p.model()); },
+          "Names of the states (a clock state \"t\" last if the model uses the time t).")
+      .def_property_readonly(
+          "control_names", [](const Problem& p) { return control_names(p.model()); },
+          "Names of the controls.")
+      .def_property_readonly(
+          "parameters",
+          [](const Problem& p) {
+            const Eigen::VectorXd values = p.is_ocp()
+                                               ? std::get<fesd::OcpProblem>(p.value).ocp.p
+                                               : std::get<fesd::SimulationProblem>(p.value).p;
+            py::dict d;
+            const auto& names = p.model().parameter_names;
+            for (Eigen::Index i = 0; i < values.size(); ++i) {
+              const auto k = static_cast<std::size_t>(i);
+              d[py::str(k < names.size() ? names[k] : numbered("p", static_cast<int>(i)))] =
+                  values[i];
+            }
+            return d;
+          },
+          "The parameter values {name: value} ([model] p).")
+      .def_property_readonly(
+          "x0",
+          [](const Problem& p) {
+            return vector_array(p.is_ocp() ? std::get<fesd::OcpProblem>(p.value).ocp.x0
+                                           : std::get<fesd::SimulationProblem>(p.value).x0);
+          },
+          "The initial state (the guess of x0 for an OCP with a free x0).")
+      .def_property_readonly(
+          "n_regions", [](const Problem& p) { return p.model().n_theta(); },
+          "Number of regions (rows of the stacked sign matrices).")
+      .def(py::pickle(&problem_state, &problem_from_state))
+      .def("__repr__", [](const Problem& p) {
+        return p.visit([&](const auto& q) {
+          return "<fesd.Problem " + std::string(p.is_ocp() ? "ocp" : "simulation") + " '" + q.name +
+                 "' from " + q.source + ">";
+        });
+      });
+
+  m.def("_load", &load, py::arg("path"),
+        "Reads a problem file (simulation or OCP); raises InputError on bad input.");
+  m.def("_parse", &parse, py::arg("text"), py::arg("source_name"), py::arg("ocp"),
+        "Reads a problem from TOML text; `source_name` is used in messages.");
+  m.def("_with_overrides", &with_overrides, py::arg("problem"), py::arg("overrides"),
+        "A copy of the problem with (key, value) overrides applied as the CLI applies them.");
+  m.def("_simulate", &simulate, py::arg("problem"), py::arg("overrides"),
+        "Simulates (the GIL released) and returns the result as a dict of plain data.");
+  m.def("_solve", &solve, py::arg("problem"), py::arg("overrides"),
+        "Solves the OCP (the GIL released) and returns the result as a dict of plain data.");
+}
