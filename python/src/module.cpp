@@ -92,6 +92,27 @@ py::array_t<double> matrix_array(const std::vector<Eigen::VectorXd>& rows, Eigen
   return a;
 }
 
+/// An Eigen matrix as an (rows, cols) array.
+py::array_t<double> dense_array(const Eigen::MatrixXd& M) {
+  py::array_t<double> a({static_cast<py::ssize_t>(M.rows()), static_cast<py::ssize_t>(M.cols())});
+  auto m = a.mutable_unchecked<2>();
+  for (Eigen::Index i = 0; i < M.rows(); ++i)
+    for (Eigen::Index j = 0; j < M.cols(); ++j)
+      m(static_cast<py::ssize_t>(i), static_cast<py::ssize_t>(j)) = M(i, j);
+  return a;
+}
+
+py::dict sensitivities_dict(const fesd::Sensitivities& s) {
+  py::dict d;
+  d["requested"] = s.requested;
+  d["available"] = s.available;
+  d["message"] = s.message;
+  d["x0"] = dense_array(s.x0);
+  d["u"] = dense_array(s.u);
+  d["p"] = dense_array(s.p);
+  return d;
+}
+
 py::dict homotopy_row(const fesd::HomotopyRow& r) {
   py::dict d;
   d["k"] = r.k;
@@ -154,6 +175,7 @@ py::dict summary_dict(const fesd::Summary& s) {
   d["active_set_path_steps"] = s.active_set_path_steps;
   d["homotopy_path_steps"] = s.homotopy_path_steps;
   d["newton_iterations"] = s.newton_iterations;
+  d["newton_factorizations"] = s.newton_factorizations;
   d["active_set_tries"] = s.active_set_tries;
   d["active_set_s"] = s.active_set_s;
   d["active_set_solves"] = s.active_set_solves;
@@ -255,6 +277,7 @@ py::dict simulation_dict(const fesd::SimulationProblem& problem, const fesd::Int
   d["homotopy"] = homotopy;
   d["summary"] = summary_dict(r.summary);
   d["accuracy"] = accuracy_dict(r.accuracy);
+  d["sensitivities"] = sensitivities_dict(r.sensitivities);
   d["x_final"] = vector_array(r.x_final());
   d["brief_report"] = r.brief_report();
   d["full_report"] = r.full_report();

@@ -123,3 +123,15 @@ def test_problems_pickle(examples):
     np.testing.assert_array_equal(fesd.simulate(q, N_sim=10).x, fesd.simulate(p, N_sim=10).x)
     d = pickle.loads(pickle.dumps(fesd.load(example3(), name="ex3")))
     assert d.name == "example3" and d.source == "ex3"
+
+
+def test_sensitivities_of_example_3a(examples):
+    # Example 3(a), x' in 2 - sign(x), x0 = -1 (examples/crossing.toml): dx(T)/dx0 = 1/3
+    # (docs/sensitivities.md); the model has no controls or parameters.
+    r = fesd.simulate(examples / "crossing.toml", sensitivities=True, error_estimate=False)
+    s = r.sensitivities
+    assert s["requested"] and s["available"], s["message"]
+    assert s["x0"].shape == (1, 1)
+    assert abs(s["x0"][0, 0] - 1.0 / 3.0) < 1e-12
+    assert s["u"].shape == (1, 0) and s["p"].shape == (1, 0)
+    assert not fesd.simulate(examples / "crossing.toml").sensitivities["requested"]
