@@ -36,6 +36,7 @@
 #include <fesd/options.hpp>
 
 #include "bench_args.hpp"
+#include "bench_timing.hpp"
 #include "oscillator_model.hpp"
 #include "sensitivity_ocp.hpp"
 #ifdef FESD_BENCH_CVODE
@@ -53,6 +54,9 @@ namespace fesd_bench {
 }  // namespace fesd_bench
 
 namespace {
+
+using fesd_bench::cpu_now;
+using fesd_bench::median;
 
 /// Example 3(b): x' in -sign(x) (region 0: x > 0, x' = -1; region 1: x < 0, x' = 1).
 struct SlidingModel {
@@ -113,17 +117,6 @@ struct Row {
   int active_set_steps = 0, homotopy_steps = 0, tries = 0;
   double error_x = 0, error_t_s = 0;
 };
-
-double cpu_now() {
-  timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
 
 Row measure(const Case& c, int N_sim, fesd::StepSolver solver, int repeats) {
   fesd::IntegratorOptions o;

@@ -33,6 +33,7 @@
 #include <fesd/ocp.hpp>
 
 #include "bench_args.hpp"
+#include "bench_timing.hpp"
 #include "nlp/kkt/kkt_module.h"
 #include "sliding_ocp.hpp"
 
@@ -51,13 +52,10 @@ void usage(const std::string& why, int exit_code) {
 
 namespace {
 
+using fesd_bench::cpu_now;
+
 /// Process CPU time in seconds. Everything timed here runs on this one thread (MUMPS is the
 /// sequential build); on a machine shared with builds, wall time varied by +-30 %, CPU time less.
-double cpu_now() {
-  timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
 double seconds_since(double t0) {
   return cpu_now() - t0;
 }

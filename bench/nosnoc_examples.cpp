@@ -43,6 +43,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bench_args.hpp"
+#include "bench_timing.hpp"
 
 extern char** environ;
 
@@ -58,6 +59,8 @@ void usage(const std::string& why, int exit_code) {
 }  // namespace fesd_bench
 
 namespace {
+
+using fesd_bench::median;
 
 namespace fs = std::filesystem;
 
@@ -190,11 +193,6 @@ struct Row {
   std::vector<double> wall_s, cpu_s, run_s;  // run_s: the report's own "wall time"
   double median_wall = NAN, median_cpu = NAN, median_run = NAN;
 };
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.empty() ? NAN : v[v.size() / 2];
-}
 
 std::string result_text(const Row& r) {
   if (!std::isnan(r.objective)) return fmt::format("J = {:.6g}", r.objective);

@@ -1,5 +1,6 @@
 // bench/cvode/cvode_oscillator.cpp: see cvode_oscillator.hpp.
 #include "cvode_oscillator.hpp"
+#include "../bench_timing.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -16,6 +17,9 @@
 
 namespace fesd_bench {
 namespace {
+
+using fesd_bench::cpu_now;
+using fesd_bench::median;
 
 constexpr double kOmega = 2.0 * std::numbers::pi;
 
@@ -46,17 +50,6 @@ int root(sunrealtype, N_Vector y, sunrealtype* g, void*) {
   const double* x = N_VGetArrayPointer(y);
   g[0] = x[0] * x[0] + x[1] * x[1] - 1.0;
   return 0;
-}
-
-double cpu_now() {
-  timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.empty() ? NAN : v[v.size() / 2];
 }
 
 }  // namespace
