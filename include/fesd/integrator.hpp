@@ -95,6 +95,10 @@ struct IntegratorResult {
   /// One homotopy per solve attempt: one per integration step, more where a step was retried as
   /// half steps (Summary::split_steps; the failed attempt comes first).
   std::vector<std::vector<HomotopyRow>> homotopy;
+  /// Per integration step (N_sim entries for a complete run): the path that solved it, active_set
+  /// (Newton, the step possibly in half or quarter pieces) or homotopy (every step of the
+  /// standard method and of step_solver = homotopy, the active-set path's fallbacks).
+  std::vector<StepSolver> step_path;
   Summary summary;
   /// The error estimate and the runs behind it (simulate() only).
   Accuracy accuracy;

@@ -282,6 +282,8 @@ class SimulationResult(_Result):
           warnings).
       accuracy (dict): error_estimate of x(T), switch_time_estimate, order, tol_sim, met,
           N_sim, note, runs (one dict per integration made).
+      step_path (list of str): per integration step the path that solved it, "active_set" or
+          "homotopy".
       sensitivities (dict): with ``sensitivities=True``, dx(T)/dx0 as ``x0`` (n_x, n_x), dx(T)/du
           as ``u`` (n_x, n_u), dx(T)/dp as ``p`` (n_x, n_p) (docs/sensitivities.md); ``available``
           (bool) and ``message`` (why not); empty arrays when not requested.

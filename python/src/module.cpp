@@ -278,6 +278,9 @@ py::dict simulation_dict(const fesd::SimulationProblem& problem, const fesd::Int
   d["summary"] = summary_dict(r.summary);
   d["accuracy"] = accuracy_dict(r.accuracy);
   d["sensitivities"] = sensitivities_dict(r.sensitivities);
+  py::list step_path;
+  for (fesd::StepSolver s : r.step_path) step_path.append(std::string(fesd::to_string(s)));
+  d["step_path"] = step_path;
   d["x_final"] = vector_array(r.x_final());
   d["brief_report"] = r.brief_report();
   d["full_report"] = r.full_report();

@@ -160,6 +160,7 @@ class Integrator {
       ++res_.summary.homotopy_path_steps;
       ok = advance(0);
     }
+    if (ok) res_.step_path.push_back(by_newton ? StepSolver::ActiveSet : StepSolver::Homotopy);
     if (options_.on_step) {
       StepProgress p{step + 1, N_sim_, t_, 0, 0, 0.0, Status::Success};
       if (by_newton) {

@@ -275,6 +275,8 @@ void write_json(const IntegratorResult& result, const Pss& model, const std::str
   j["active_set"] = result.active_set;
   j["switches"] = switches(result.switches);
   j["homotopy"] = homotopy(result.homotopy);
+  j["step_path"] = json::array();
+  for (StepSolver s : result.step_path) j["step_path"].push_back(std::string(to_string(s)));
   j["state_names"] = state_names_of(result, model);
   if (result.sensitivities.requested) j["sensitivities"] = sensitivities(result.sensitivities);
   std::string text;

@@ -258,6 +258,13 @@ TEST(ActiveSetSliding, TemperatureControlSameAsHomotopy) {
   EXPECT_NEAR(b.active.switches[1].t, 0.5, 1e-9);
   EXPECT_GE(b.active.summary.active_set_path_steps, 25);
   EXPECT_LE(b.active.summary.homotopy_path_steps, 5);
+  // the result says per step which path solved it
+  ASSERT_EQ(b.active.step_path.size(), 30u);
+  EXPECT_EQ(std::count(b.active.step_path.begin(), b.active.step_path.end(), StepSolver::Homotopy),
+            b.active.summary.homotopy_path_steps);
+  EXPECT_EQ(
+      std::count(b.homotopy.step_path.begin(), b.homotopy.step_path.end(), StepSolver::Homotopy),
+      30);
 }
 
 // examples/periodic_stick_slip.toml (nosnoc_py's codim-2 example: one subsystem, four regions of
@@ -427,6 +434,7 @@ TEST(ActiveSetOptions, StandardMethodRunsOnTheHomotopy) {
   ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
   EXPECT_EQ(r.summary.active_set_path_steps, 0);
   EXPECT_EQ(r.summary.homotopy_path_steps, 2);
+  EXPECT_EQ(r.step_path, (std::vector<StepSolver>{StepSolver::Homotopy, StepSolver::Homotopy}));
 }
 
 }  // namespace

@@ -451,6 +451,7 @@ TEST(Cli, SimulateCarriesAnErrorEstimate) {
   EXPECT_EQ(j["accuracy"]["N_sim"], 2);
   EXPECT_EQ(j["accuracy"]["runs"].size(), 3u);
   EXPECT_EQ(j["t"].size(), 5u);  // the result is the run asked for: 2 steps, 2 elements each
+  EXPECT_EQ(j["step_path"], nlohmann::json::array({"active_set", "active_set"}));
 }
 
 // REAL SOLVE: one IPOPT iteration per NLP cannot converge: exit 1, and the outputs are written.

@@ -135,3 +135,4 @@ def test_sensitivities_of_example_3a(examples):
     assert abs(s["x0"][0, 0] - 1.0 / 3.0) < 1e-12
     assert s["u"].shape == (1, 0) and s["p"].shape == (1, 0)
     assert not fesd.simulate(examples / "crossing.toml").sensitivities["requested"]
+    assert r.step_path == ["active_set"] * 10
