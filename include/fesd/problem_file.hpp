@@ -4,6 +4,8 @@
 #pragma once
 #include <string>
 #include <string_view>
+#include <utility>
+#include <vector>
 
 #include <Eigen/Dense>
 
@@ -20,13 +22,13 @@ struct SimulationProblem {
   std::string description;  ///< `description`, may be empty
   std::string source;       ///< file path (or the name given to parse_simulation_problem)
   Pss model;
-  Eigen::VectorXd x0;       ///< [model] x0 (with the clock state appended if `t` is used)
-  Eigen::VectorXd u;        ///< [simulation] u: constant control values (size n_u)
-  Eigen::VectorXd p;        ///< parameter values from [model] p (size n_p)
-  double T_sim = 0;         ///< [simulation] T_sim > 0
-  int N_sim = 0;            ///< [simulation] N_sim >= 0; 0: chosen by tol_sim (simulate())
-  double tol_sim = 0;       ///< [simulation] tol_sim >= 0 (AccuracyOptions::tol_sim)
-  int N_sim_max = 1000;     ///< [simulation] N_sim_max >= 1 (AccuracyOptions::N_sim_max)
+  Eigen::VectorXd x0;          ///< [model] x0 (with the clock state appended if `t` is used)
+  Eigen::VectorXd u;           ///< [simulation] u: constant control values (size n_u)
+  Eigen::VectorXd p;           ///< parameter values from [model] p (size n_p)
+  double T_sim = 0;            ///< [simulation] T_sim > 0
+  int N_sim = 0;               ///< [simulation] N_sim >= 0; 0: chosen by tol_sim (simulate())
+  double tol_sim = 0;          ///< [simulation] tol_sim >= 0 (AccuracyOptions::tol_sim)
+  int N_sim_max = 1000;        ///< [simulation] N_sim_max >= 1 (AccuracyOptions::N_sim_max)
   bool error_estimate = true;  ///< [simulation] error_estimate (AccuracyOptions::error_estimate)
   IntegratorOptions options;
   /// True if an expression uses the time `t`: then a clock state named "t" with t' = 1 is
@@ -43,7 +45,8 @@ IntegratorResult simulate(const SimulationProblem& problem,
 /// InvalidOption with "file:line: what is wrong" messages.
 SimulationProblem load_simulation_problem(const std::string& path);
 /// Same, from text; `source_name` is used in messages.
-SimulationProblem parse_simulation_problem(std::string_view toml_text, std::string_view source_name);
+SimulationProblem parse_simulation_problem(std::string_view toml_text,
+                                           std::string_view source_name);
 
 /// Overrides one option as if it had been written in the file, e.g. ("n_s", "3"),
 /// ("rk_scheme", "gauss_legendre"), ("use_fesd", "0"), ("N_sim", "40"). Accepts every key of the
@@ -82,6 +85,19 @@ OcpProblem parse_ocp_problem(std::string_view toml_text, std::string_view source
 /// N_finite_elements (alias N_FE) sets the same number for every control interval. Throws
 /// fesd::InvalidOption naming the key; on error the problem is unchanged.
 void apply_override(OcpProblem& problem, std::string_view key, std::string_view value);
+
+/// Option overrides as (key, value) pairs, in the order they were given (CLI flags, Python
+/// keywords).
+using OverrideList = std::vector<std::pair<std::string, std::string>>;
+
+/// Applies several overrides with apply_override(). apply_override re-validates after every key,
+/// so a combination that is valid only as a whole (e.g. rk_scheme = lobatto_iiia with n_s = 2
+/// when the file has n_s = 1) may fail in one order and succeed in another: keys that fail are
+/// retried as long as others succeed. Throws fesd::InvalidOption with the first remaining
+/// failure's message.
+void apply_overrides(SimulationProblem& problem, const OverrideList& overrides);
+/// Same for an optimal control problem.
+void apply_overrides(OcpProblem& problem, const OverrideList& overrides);
 
 /// What a problem file describes: a simulation ([simulation]) or an optimal control problem
 /// ([ocp]).

@@ -25,7 +25,7 @@ namespace py = pybind11;
 
 namespace {
 
-using Overrides = std::vector<std::pair<std::string, std::string>>;
+using Overrides = fesd::OverrideList;
 
 /// A problem file's content: a simulation or an optimal control problem, with the text it was
 /// read from and the overrides applied since, so that it pickles (read again from both).
@@ -45,26 +45,6 @@ struct Problem {
     return std::visit(std::forward<F>(f), value);
   }
 };
-
-/// Applies (key, value) overrides as the CLI does: apply_override re-validates after every key, so
-/// keys that fail are retried as long as others succeed; the first remaining failure is thrown.
-template <class P>
-void apply_overrides(P& problem, Overrides pending) {
-  while (!pending.empty()) {
-    Overrides failed;
-    std::string first_error;
-    for (const auto& [key, value] : pending) {
-      try {
-        fesd::apply_override(problem, key, value);
-      } catch (const fesd::InvalidOption& e) {
-        if (failed.empty()) first_error = e.what();
-        failed.emplace_back(key, value);
-      }
-    }
-    if (failed.size() == pending.size()) throw fesd::InvalidOption(first_error);
-    pending = std::move(failed);
-  }
-}
 
 py::array_t<double> vector_array(const std::vector<double>& v) {
   py::array_t<double> a(static_cast<py::ssize_t>(v.size()));
@@ -350,7 +330,7 @@ Problem parse(const std::string& text, const std::string& source_name, bool ocp)
 
 Problem with_overrides(const Problem& problem, const Overrides& overrides) {
   Problem copy = problem;
-  std::visit([&](auto& p) { apply_overrides(p, overrides); }, copy.value);
+  std::visit([&](auto& p) { fesd::apply_overrides(p, overrides); }, copy.value);
   copy.overrides.insert(copy.overrides.end(), overrides.begin(), overrides.end());
   return copy;
 }
@@ -372,7 +352,7 @@ py::dict simulate(const Problem& problem, const Overrides& overrides) {
     throw fesd::InvalidOption(
         "an optimal control problem ([ocp] table): use fesd.solve, not fesd.simulate");
   fesd::SimulationProblem p = std::get<fesd::SimulationProblem>(problem.value);
-  apply_overrides(p, overrides);
+  fesd::apply_overrides(p, overrides);
   fesd::IntegratorResult r;
   {
     py::gil_scoped_release release;
@@ -386,7 +366,7 @@ py::dict solve(const Problem& problem, const Overrides& overrides) {
     throw fesd::InvalidOption(
         "a simulation problem (no [ocp] table): use fesd.simulate, not fesd.solve");
   fesd::OcpProblem p = std::get<fesd::OcpProblem>(problem.value);
-  apply_overrides(p, overrides);
+  fesd::apply_overrides(p, overrides);
   fesd::OcpResult r;
   {
     py::gil_scoped_release release;

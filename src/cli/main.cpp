@@ -276,29 +276,6 @@ std::vector<std::string> cli11_args(int argc, char** argv) {
   return {args.rbegin(), args.rend()};
 }
 
-/// Applies the overrides. apply_override re-validates after every key, so a combination that is
-/// valid only as a whole (e.g. rk_scheme = lobatto_iiia together with n_s = 2 when the file has
-/// n_s = 1) may fail in one order and succeed in another: keys that fail are retried as long as
-/// others succeed; the first remaining failure is reported.
-template <class Problem>  // fesd::SimulationProblem or fesd::OcpProblem
-void apply_overrides(Problem& problem, const Overrides& overrides) {
-  std::vector<std::pair<std::string, std::string>> pending = overrides.pairs();
-  while (!pending.empty()) {
-    std::vector<std::pair<std::string, std::string>> failed;
-    std::string first_error;
-    for (const auto& [key, value] : pending) {
-      try {
-        fesd::apply_override(problem, key, value);
-      } catch (const fesd::InvalidOption& e) {
-        if (failed.empty()) first_error = e.what();
-        failed.emplace_back(key, value);
-      }
-    }
-    if (failed.size() == pending.size()) throw fesd::InvalidOption(first_error);
-    pending = std::move(failed);
-  }
-}
-
 // ---- checks before solving ---------------------------------------------------------------------
 
 void check_input_file(const std::string& path) {
@@ -499,7 +476,7 @@ Problem load(const std::string& file, const Overrides& overrides) {
   } else {
     problem = fesd::load_simulation_problem(file);
   }
-  apply_overrides(problem, overrides);
+  fesd::apply_overrides(problem, overrides.pairs());
   if (const std::vector<std::string> errors = fesd::validate(problem.options); !errors.empty()) {
     std::string all;
     for (const std::string& e : errors) all += (all.empty() ? "" : "; ") + e;

@@ -149,4 +149,33 @@ void apply_override(SimulationProblem& problem, std::string_view key, std::strin
   problem = std::move(updated);
 }
 
+namespace {
+template <class Problem>  // SimulationProblem or OcpProblem
+void apply_all(Problem& problem, const OverrideList& overrides) {
+  OverrideList pending = overrides;
+  while (!pending.empty()) {
+    OverrideList failed;
+    std::string first_error;
+    for (const auto& [key, value] : pending) {
+      try {
+        apply_override(problem, key, value);
+      } catch (const InvalidOption& e) {
+        if (failed.empty()) first_error = e.what();
+        failed.emplace_back(key, value);
+      }
+    }
+    if (failed.size() == pending.size()) throw InvalidOption(first_error);
+    pending = std::move(failed);
+  }
+}
+}  // namespace
+
+void apply_overrides(SimulationProblem& problem, const OverrideList& overrides) {
+  apply_all(problem, overrides);
+}
+
+void apply_overrides(OcpProblem& problem, const OverrideList& overrides) {
+  apply_all(problem, overrides);
+}
+
 }  // namespace fesd
