@@ -186,7 +186,8 @@ def simulate(problem, options=None, **overrides):
     Example: ``fesd.simulate("examples/oscillator.toml", n_s=3, N_sim=40).x[-1]``
     """
     p = load(problem)
-    return SimulationResult(_fesd._simulate(p, _override_pairs(options, overrides)))
+    pairs = _override_pairs(options, overrides)
+    return _with_source(SimulationResult(_fesd._simulate(p, pairs)), p, pairs)
 
 
 def solve(problem, options=None, **overrides):
@@ -201,7 +202,16 @@ def solve(problem, options=None, **overrides):
     Example: ``fesd.solve("examples/ocp_sensitivity.toml").objective``
     """
     p = load(problem)
-    return OcpResult(_fesd._solve(p, _override_pairs(options, overrides)))
+    pairs = _override_pairs(options, overrides)
+    return _with_source(OcpResult(_fesd._solve(p, pairs)), p, pairs)
+
+
+def _with_source(result, problem, pairs):
+    """Keeps the problem and overrides of a two-state result: its plot draws the switching
+    surfaces, which need the model (computed only when plotted)."""
+    if len(result.state_names) == 2:
+        result._source = (problem, pairs)
+    return result
 
 
 def with_options(problem, options=None, **overrides):

@@ -57,17 +57,69 @@ def _step_panel(ax, result, ylabel):
     ax.set_ylabel(label)
 
 
+def _phase_box(result):
+    """The trajectory's bounding box (element boundaries and stage points), 10 % wider on each
+    side, as the program's phase portrait takes it."""
+    pts = [np.asarray(result.x)[:, :2]]
+    xs = np.asarray(result.x_stage)
+    if xs.ndim == 2 and xs.shape[0] > 0 and xs.shape[1] >= 2:
+        pts.append(xs[:, :2])
+    pts = np.vstack(pts)
+    pts = pts[np.all(np.isfinite(pts), axis=1)]
+    box = []
+    for j in range(2):
+        if pts.shape[0] == 0:
+            box += [-1.0, 1.0]
+            continue
+        lo, hi = float(pts[:, j].min()), float(pts[:, j].max())
+        w = 0.1 * (hi - lo)
+        if not w > 1e-12 * (1 + max(abs(lo), abs(hi))):
+            w = max(0.1 * max(abs(lo), abs(hi)), 1e-3)
+        box += [lo - w, hi + w]
+    return box
+
+
+def _switching_surfaces(result, box):
+    """[(label, segments (k, 4))] of the model's switching surfaces in the box; [] when the
+    result does not carry its problem (fesd.simulate/solve keep it for two-state systems)."""
+    source = result.__dict__.get("_source")
+    if source is None:
+        return []
+    from . import _fesd
+    problem, pairs = source
+    if pairs:
+        problem = _fesd._with_overrides(problem, pairs)
+    return _fesd._switching_surfaces(problem, *box)
+
+
 def _phase_portrait(ax, result):
     x = np.asarray(result.x)
-    ax.plot(x[:, 0], x[:, 1], color="C0")
-    ax.plot(x[0, 0], x[0, 1], "o", color="C0", markersize=4)
+    box = _phase_box(result)
+    # The surfaces on a square around the box, wider than it: the equal aspect widens the view.
+    cx, cy = 0.5 * (box[0] + box[1]), 0.5 * (box[2] + box[3])
+    half = 0.8 * max(box[1] - box[0], box[3] - box[2])
+    for i, (label, seg) in enumerate(
+            _switching_surfaces(result, [cx - half, cx + half, cy - half, cy + half])):
+        xs = np.column_stack([seg[:, 0], seg[:, 2], np.full(len(seg), np.nan)]).ravel()
+        ys = np.column_stack([seg[:, 1], seg[:, 3], np.full(len(seg), np.nan)]).ravel()
+        ax.plot(xs, ys, color=str(0.45 + 0.1 * (i % 3)), linewidth=1.2, zorder=1, label=label)
+    t = np.asarray(result.t)
+    for k, (t0, t1) in enumerate(_sliding_intervals(result)):
+        on = (t >= t0) & (t <= t1)
+        ax.plot(x[on, 0], x[on, 1], color="C1", linewidth=6, alpha=0.5, zorder=2,
+                solid_capstyle="round", label="sliding" if k == 0 else None)
+    ax.plot(x[:, 0], x[:, 1], color="C0", zorder=3, label="x(t)")
+    ax.plot(x[0, 0], x[0, 1], "o", color="C0", markersize=4, zorder=3)
     for s in result.switches:
         i = int(np.searchsorted(result.t, s["t"]))
         if i < len(x):
-            ax.plot(x[i, 0], x[i, 1], "x", color="C3")
+            ax.plot(x[i, 0], x[i, 1], "x", color="C3", zorder=4)
+    ax.set_xlim(box[0], box[1])
+    ax.set_ylim(box[2], box[3])
     ax.set_xlabel(result.state_names[0])
     ax.set_ylabel(result.state_names[1])
     ax.set_aspect("equal", adjustable="datalim")
+    ax.legend(loc="best", fontsize=8)
     ax.set_title("phase portrait", fontsize=10)
 
 
@@ -79,7 +131,7 @@ def plot(result, path=None, title=None):
     boundaries; for an OCP the controls (steps on the control grid) and the switching indicator
     eta_n of (31) (log scale; eta_n = 0, a switch, marked at the bottom); the step sizes h_n
     (h_n / h_ref - 1 when they all agree to 4 digits). A two-state system gets a phase portrait
-    on the right. ``path``: also saved there (PNG, SVG, PDF: by its suffix). ``title``: default
+    on the right, with the switching surfaces (c = 0, or g_i = g_j) and the sliding parts. ``path``: also saved there (PNG, SVG, PDF: by its suffix). ``title``: default
     the problem's name and status.
     """
     import matplotlib.pyplot as plt
@@ -89,7 +141,8 @@ def plot(result, path=None, title=None):
     n_x = x.shape[1] if x.ndim == 2 else 0
     n_u = np.asarray(result.u).shape[1] if ocp and np.asarray(result.u).ndim == 2 else 0
     rows = ["x"] + (["u"] if n_u > 0 else []) + ["h"] + (["eta"] if ocp else [])
-    portrait = n_x == 2 and x.shape[0] > 1
+    # No portrait when one of the two states is the clock "t" (as the program's --plot).
+    portrait = n_x == 2 and x.shape[0] > 1 and "t" not in list(result.state_names)[:2]
     fig = plt.figure(figsize=(15 if portrait else 10, 2.2 + 1.8 * len(rows)))
     grid = fig.add_gridspec(len(rows), 2 if portrait else 1,
                             width_ratios=[1.8, 1] if portrait else None,

@@ -20,6 +20,7 @@
 #include "fesd/problem_file.hpp"
 #include "fesd/status.hpp"
 #include "fesd/summary.hpp"
+#include "io/plot_parts.hpp"
 
 namespace py = pybind11;
 
@@ -375,6 +376,32 @@ py::dict solve(const Problem& problem, const Overrides& overrides) {
   return ocp_dict(p, r);
 }
 
+/// The switching surfaces of a two-state model in the box [xlo, xhi] x [ylo, yhi], as the
+/// program's phase portrait draws them: (label, (k, 4) array of segments x0, y0, x1, y1) per
+/// surface; empty for other models.
+py::list switching_surfaces(const Problem& problem, double xlo, double xhi, double ylo,
+                            double yhi, int n_grid) {
+  const fesd::Pss& model = problem.model();
+  Eigen::VectorXd p = problem.is_ocp() ? std::get<fesd::OcpProblem>(problem.value).ocp.p
+                                       : std::get<fesd::SimulationProblem>(problem.value).p;
+  if (p.size() == 0) p = model.p_default;
+  py::list out;
+  for (const auto& [label, segments] :
+       fesd::io_detail::switching_surfaces(model, p, xlo, xhi, ylo, yhi, n_grid)) {
+    py::array_t<double> a({static_cast<py::ssize_t>(segments.size()), py::ssize_t{4}});
+    auto m = a.mutable_unchecked<2>();
+    for (std::size_t i = 0; i < segments.size(); ++i) {
+      const auto k = static_cast<py::ssize_t>(i);
+      m(k, 0) = segments[i].x0;
+      m(k, 1) = segments[i].y0;
+      m(k, 2) = segments[i].x1;
+      m(k, 3) = segments[i].y1;
+    }
+    out.append(py::make_tuple(label, a));
+  }
+  return out;
+}
+
 }  // namespace
 
 PYBIND11_MODULE(_fesd, m) {
@@ -465,4 +492,8 @@ PYBIND11_MODULE(_fesd, m) {
         "Simulates (the GIL released) and returns the result as a dict of plain data.");
   m.def("_solve", &solve, py::arg("problem"), py::arg("overrides"),
         "Solves the OCP (the GIL released) and returns the result as a dict of plain data.");
+  m.def("_switching_surfaces", &switching_surfaces, py::arg("problem"), py::arg("xlo"),
+        py::arg("xhi"), py::arg("ylo"), py::arg("yhi"), py::arg("n_grid") = 161,
+        "The switching surfaces c = 0 (g_i = g_j) of a two-state model in a box: a list of "
+        "(label, (k, 4) array of segments x0, y0, x1, y1).");
 }
