@@ -21,3 +21,28 @@ message(STATUS "${out}")
 if(rc)
   message(FATAL_ERROR "the consumer program failed (${rc})")
 endif()
+
+# The Python package (docs/python.md): installed under PYTHON_DIR (relative to the prefix), it
+# imports from there with the build tree out of reach and loads the installed libfesd (RUNPATH).
+if(PYTHON AND PYTHON_DIR AND NOT IS_ABSOLUTE "${PYTHON_DIR}")
+  set(site ${WORK_DIR}/prefix/${PYTHON_DIR})
+  set(check [=[
+import sys, fesd
+prefix = sys.argv[1]
+assert fesd.__file__.startswith(prefix), fesd.__file__
+libs = [l.split()[-1] for l in open("/proc/self/maps") if "libfesd.so" in l]
+assert libs and all(l.startswith(prefix) for l in libs), libs
+r = fesd.simulate(sys.argv[2], N_sim=40, error_estimate=False)
+assert r.success and abs(r.switch_times[0] - 1) < 1e-6, r.brief_report()
+print("python: import fesd from", fesd.__file__, "-", r.brief_report())
+]=])
+  execute_process(COMMAND ${CMAKE_COMMAND} -E env PYTHONPATH=${site} PYTHONNOUSERSITE=1
+                          ${PYTHON} -c "${check}" ${WORK_DIR}/prefix
+                          ${SOURCE_DIR}/examples/oscillator.toml
+                  WORKING_DIRECTORY ${WORK_DIR} RESULT_VARIABLE rc OUTPUT_VARIABLE out
+                  ERROR_VARIABLE err)
+  message(STATUS "${out}")
+  if(rc)
+    message(FATAL_ERROR "the installed Python package failed (${rc}): ${err}")
+  endif()
+endif()
