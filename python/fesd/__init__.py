@@ -119,7 +119,9 @@ def load(source, name="<dict>", **tables):
     if isinstance(source, dict):
         merged = dict(source)
         merged.update(tables)
-        return _fesd._parse(to_toml(merged), str(name), "ocp" in merged)
+        model = merged.get("model")
+        projected = isinstance(model, dict) and model.get("kind") == "projected"
+        return _fesd._parse(to_toml(merged), str(name), "ocp" in merged, projected)
     if tables:
         raise InputError("load: table keyword arguments go with a dict or None, not a file")
     if isinstance(source, (str, os.PathLike)):

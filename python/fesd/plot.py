@@ -14,15 +14,17 @@ def _switch_label(s):
 
 
 def _sliding_intervals(result):
-    """(t_start, t_end) of runs of elements where a subsystem has two or more active regions."""
+    """(t_start, t_end) of runs of elements where a subsystem has two or more active regions (a
+    projected system: where some constraint is active, i.e. in contact)."""
     subsystem = result.region_subsystem
+    projected = getattr(result, "projected", False)
     out = []
     for n, active in enumerate(result.active_set):
         counts = {}
         for r in active:
             k = subsystem[r] if r < len(subsystem) else 0
             counts[k] = counts.get(k, 0) + 1
-        if any(c >= 2 for c in counts.values()):
+        if (projected and len(active) > 0) or any(c >= 2 for c in counts.values()):
             t0, t1 = result.t[n], result.t[n + 1]
             if out and out[-1][1] == t0:
                 out[-1] = (out[-1][0], t1)
@@ -107,7 +109,9 @@ def _phase_portrait(ax, result):
     for k, (t0, t1) in enumerate(_sliding_intervals(result)):
         on = (t >= t0) & (t <= t1)
         ax.plot(x[on, 0], x[on, 1], color="C1", linewidth=6, alpha=0.5, zorder=2,
-                solid_capstyle="round", label="sliding" if k == 0 else None)
+                solid_capstyle="round",
+                label=("contact" if getattr(result, "projected", False) else "sliding")
+                if k == 0 else None)
     ax.plot(x[:, 0], x[:, 1], color="C0", zorder=3, label="x(t)")
     ax.plot(x[0, 0], x[0, 1], "o", color="C0", markersize=4, zorder=3)
     for s in result.switches:

@@ -6,10 +6,12 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <array>
 #include <fstream>
 #include <sstream>
 #include <string>
 #include <tuple>
+#include <type_traits>
 #include <utility>
 #include <variant>
 #include <vector>
@@ -17,6 +19,7 @@
 #include "fesd/error.hpp"
 #include "fesd/integrator.hpp"
 #include "fesd/ocp.hpp"
+#include "fesd/pds_problem_file.hpp"
 #include "fesd/problem_file.hpp"
 #include "fesd/status.hpp"
 #include "fesd/summary.hpp"
@@ -28,24 +31,67 @@ namespace {
 
 using Overrides = fesd::OverrideList;
 
-/// A problem file's content: a simulation or an optimal control problem, with the text it was
-/// read from and the overrides applied since, so that it pickles (read again from both).
+/// The model, initial state and parameter values of each kind of problem.
+const fesd::Pss& model_of(const fesd::SimulationProblem& p) {
+  return p.model;
+}
+const fesd::Pss& model_of(const fesd::OcpProblem& p) {
+  return p.ocp.model;
+}
+const fesd::Pds& model_of(const fesd::PdsSimulationProblem& p) {
+  return p.model;
+}
+const Eigen::VectorXd& x0_of(const fesd::SimulationProblem& p) {
+  return p.x0;
+}
+const Eigen::VectorXd& x0_of(const fesd::OcpProblem& p) {
+  return p.ocp.x0;
+}
+const Eigen::VectorXd& x0_of(const fesd::PdsSimulationProblem& p) {
+  return p.x0;
+}
+/// The parameter values a run uses (an OCP's empty p means the model's defaults).
+Eigen::VectorXd p_of(const fesd::SimulationProblem& p) {
+  return p.p;
+}
+Eigen::VectorXd p_of(const fesd::OcpProblem& p) {
+  return p.ocp.p.size() > 0 ? p.ocp.p : p.ocp.model.p_default;
+}
+Eigen::VectorXd p_of(const fesd::PdsSimulationProblem& p) {
+  return p.p;
+}
+
+/// A problem file's content: a simulation or an optimal control problem of a piecewise smooth
+/// system, or a simulation of a projected one ([model] kind = "projected", docs/pds.md), with the
+/// text it was read from and the overrides applied since, so that it pickles (read again from
+/// both).
 struct Problem {
-  std::variant<fesd::SimulationProblem, fesd::OcpProblem> value;
+  std::variant<fesd::SimulationProblem, fesd::OcpProblem, fesd::PdsSimulationProblem> value;
   std::string text;         ///< the TOML text (empty: the file could not be read again)
   std::string source_name;  ///< the file or the name given for a dict
   Overrides overrides;      ///< applied in this order after reading
 
   bool is_ocp() const { return std::holds_alternative<fesd::OcpProblem>(value); }
-  const fesd::Pss& model() const {
-    return is_ocp() ? std::get<fesd::OcpProblem>(value).ocp.model
-                    : std::get<fesd::SimulationProblem>(value).model;
-  }
+  bool is_projected() const { return std::holds_alternative<fesd::PdsSimulationProblem>(value); }
   template <class F>
   decltype(auto) visit(F&& f) const {
     return std::visit(std::forward<F>(f), value);
   }
 };
+
+/// Overrides of a problem (fesd::apply_overrides); projected models take none yet (as in the
+/// program).
+template <class P>
+void apply_problem_overrides(P& problem, const Overrides& overrides) {
+  if constexpr (std::is_same_v<P, fesd::PdsSimulationProblem>) {
+    if (!overrides.empty())
+      throw fesd::InvalidOption(
+          "option overrides are not supported for projected models ([model] kind = "
+          "\"projected\") yet");
+  } else {
+    fesd::apply_overrides(problem, overrides);
+  }
+}
 
 py::array_t<double> vector_array(const std::vector<double>& v) {
   py::array_t<double> a(static_cast<py::ssize_t>(v.size()));
@@ -208,14 +254,16 @@ std::string numbered(const char* prefix, int i) {
   return name;
 }
 
-std::vector<std::string> state_names(const fesd::Pss& model) {
+template <class Model>  // fesd::Pss or fesd::Pds
+std::vector<std::string> state_names(const Model& model) {
   std::vector<std::string> names = model.state_names;
   for (int i = static_cast<int>(names.size()); i < model.n_x(); ++i)
     names.push_back(numbered("x", i));
   return names;
 }
 
-std::vector<std::string> control_names(const fesd::Pss& model) {
+template <class Model>
+std::vector<std::string> control_names(const Model& model) {
   std::vector<std::string> names = model.control_names;
   for (int i = static_cast<int>(names.size()); i < model.n_u(); ++i)
     names.push_back(numbered("u", i));
@@ -233,10 +281,28 @@ std::vector<int> region_subsystem(const fesd::Pss& model) {
   return out;
 }
 
-py::dict simulation_dict(const fesd::SimulationProblem& problem, const fesd::IntegratorResult& r) {
-  const fesd::Pss& m = problem.model;
+/// Widths of a simulation result's stage arrays: theta and lambda (Stewart: n_theta each), mu
+/// (n_sys); a projected model has no theta or mu and one lambda per constraint.
+struct StageWidths {
+  Eigen::Index theta, lambda, mu;
+};
+StageWidths stage_widths(const fesd::Pss& m) {
+  return {m.n_theta(), m.n_theta(), m.n_sys()};
+}
+StageWidths stage_widths(const fesd::Pds& m) {
+  return {0, m.n_c(), 0};
+}
+std::vector<int> region_subsystem(const fesd::Pds&) {
+  return {};
+}
+
+template <class SimProblem>  // fesd::SimulationProblem or fesd::PdsSimulationProblem
+py::dict simulation_dict(const SimProblem& problem, const fesd::IntegratorResult& r) {
+  const auto& m = problem.model;
+  const StageWidths w = stage_widths(m);
   py::dict d;
   d["kind"] = "simulation";
+  d["projected"] = std::is_same_v<SimProblem, fesd::PdsSimulationProblem>;
   d["name"] = problem.name;
   d["state_names"] = state_names(m);
   d["region_subsystem"] = region_subsystem(m);
@@ -247,9 +313,9 @@ py::dict simulation_dict(const fesd::SimulationProblem& problem, const fesd::Int
   d["h"] = vector_array(r.h);
   d["t_stage"] = vector_array(r.t_stage);
   d["x_stage"] = matrix_array(r.x_stage, m.n_x());
-  d["theta"] = matrix_array(r.theta, m.n_theta());
-  d["lambda_"] = matrix_array(r.lambda, m.n_theta());
-  d["mu"] = matrix_array(r.mu, m.n_sys());
+  d["theta"] = matrix_array(r.theta, w.theta);
+  d["lambda_"] = matrix_array(r.lambda, w.lambda);
+  d["mu"] = matrix_array(r.mu, w.mu);
   d["active_set"] = r.active_set;
   d["switches"] = switch_events(r.switches);
   d["switch_times"] = switch_times(r.switches);
@@ -272,6 +338,7 @@ py::dict ocp_dict(const fesd::OcpProblem& problem, const fesd::OcpResult& r) {
   const fesd::Pss& m = problem.ocp.model;
   py::dict d;
   d["kind"] = "ocp";
+  d["projected"] = false;
   d["name"] = problem.name;
   d["state_names"] = state_names(m);
   d["control_names"] = control_names(m);
@@ -306,7 +373,9 @@ py::dict ocp_dict(const fesd::OcpProblem& problem, const fesd::OcpResult& r) {
 
 Problem load(const std::string& path) {
   Problem problem;
-  if (fesd::problem_file_kind(path) == fesd::ProblemKind::Ocp)
+  if (fesd::is_projected_problem_file(path))
+    problem.value = fesd::load_pds_simulation_problem(path);
+  else if (fesd::problem_file_kind(path) == fesd::ProblemKind::Ocp)
     problem.value = fesd::load_ocp_problem(path);
   else
     problem.value = fesd::load_simulation_problem(path);
@@ -318,9 +387,11 @@ Problem load(const std::string& path) {
   return problem;
 }
 
-Problem parse(const std::string& text, const std::string& source_name, bool ocp) {
+Problem parse(const std::string& text, const std::string& source_name, bool ocp, bool projected) {
   Problem problem;
-  if (ocp)
+  if (projected)
+    problem.value = fesd::parse_pds_simulation_problem(text, source_name);
+  else if (ocp)
     problem.value = fesd::parse_ocp_problem(text, source_name);
   else
     problem.value = fesd::parse_simulation_problem(text, source_name);
@@ -331,35 +402,43 @@ Problem parse(const std::string& text, const std::string& source_name, bool ocp)
 
 Problem with_overrides(const Problem& problem, const Overrides& overrides) {
   Problem copy = problem;
-  std::visit([&](auto& p) { fesd::apply_overrides(p, overrides); }, copy.value);
+  std::visit([&](auto& p) { apply_problem_overrides(p, overrides); }, copy.value);
   copy.overrides.insert(copy.overrides.end(), overrides.begin(), overrides.end());
   return copy;
 }
 
-using ProblemState = std::tuple<std::string, std::string, bool, Overrides>;
+using ProblemState = std::tuple<std::string, std::string, bool, Overrides, bool>;
 
 ProblemState problem_state(const Problem& p) {
   if (p.text.empty())
     throw fesd::IoError(p.source_name + ": cannot be read again to pickle the problem");
-  return {p.text, p.source_name, p.is_ocp(), p.overrides};
+  return {p.text, p.source_name, p.is_ocp(), p.overrides, p.is_projected()};
 }
 
 Problem problem_from_state(const ProblemState& s) {
-  return with_overrides(parse(std::get<0>(s), std::get<1>(s), std::get<2>(s)), std::get<3>(s));
+  return with_overrides(parse(std::get<0>(s), std::get<1>(s), std::get<2>(s), std::get<4>(s)),
+                        std::get<3>(s));
 }
 
 py::dict simulate(const Problem& problem, const Overrides& overrides) {
   if (problem.is_ocp())
     throw fesd::InvalidOption(
         "an optimal control problem ([ocp] table): use fesd.solve, not fesd.simulate");
-  fesd::SimulationProblem p = std::get<fesd::SimulationProblem>(problem.value);
-  fesd::apply_overrides(p, overrides);
-  fesd::IntegratorResult r;
-  {
-    py::gil_scoped_release release;
-    r = fesd::simulate(p);
-  }
-  return simulation_dict(p, r);
+  return problem.visit([&](const auto& q) -> py::dict {
+    using P = std::decay_t<decltype(q)>;
+    if constexpr (std::is_same_v<P, fesd::OcpProblem>) {
+      return {};  // rejected above
+    } else {
+      P p = q;
+      apply_problem_overrides(p, overrides);
+      fesd::IntegratorResult r;
+      {
+        py::gil_scoped_release release;
+        r = fesd::simulate(p);
+      }
+      return simulation_dict(p, r);
+    }
+  });
 }
 
 py::dict solve(const Problem& problem, const Overrides& overrides) {
@@ -367,7 +446,7 @@ py::dict solve(const Problem& problem, const Overrides& overrides) {
     throw fesd::InvalidOption(
         "a simulation problem (no [ocp] table): use fesd.simulate, not fesd.solve");
   fesd::OcpProblem p = std::get<fesd::OcpProblem>(problem.value);
-  fesd::apply_overrides(p, overrides);
+  apply_problem_overrides(p, overrides);
   fesd::OcpResult r;
   {
     py::gil_scoped_release release;
@@ -376,18 +455,48 @@ py::dict solve(const Problem& problem, const Overrides& overrides) {
   return ocp_dict(p, r);
 }
 
+using Surfaces = std::vector<std::pair<std::string, std::vector<fesd::io_detail::Segment>>>;
+
+Surfaces surfaces_of(const fesd::Pss& model, const Eigen::VectorXd& p, double xlo, double xhi,
+                     double ylo, double yhi, int n_grid) {
+  return fesd::io_detail::switching_surfaces(model, p, xlo, xhi, ylo, yhi, n_grid);
+}
+
+/// A projected model's boundary pieces c_k(x) = 0 (C = {x : c(x) >= 0}).
+Surfaces surfaces_of(const fesd::Pds& model, const Eigen::VectorXd& p, double xlo, double xhi,
+                     double ylo, double yhi, int n_grid) {
+  Surfaces out;
+  if (model.n_x() != 2 || p.size() != model.n_p() || n_grid < 2) return out;
+  const auto n_c = static_cast<std::size_t>(model.n_c());
+  std::vector<Eigen::MatrixXd> values(n_c, Eigen::MatrixXd(n_grid, n_grid));
+  std::vector<double> c(n_c);
+  try {
+    for (int i = 0; i < n_grid; ++i)
+      for (int j = 0; j < n_grid; ++j) {
+        const std::array<double, 2> x{xlo + (xhi - xlo) * i / (n_grid - 1),
+                                      ylo + (yhi - ylo) * j / (n_grid - 1)};
+        model.functions().c(x.data(), p.size() > 0 ? p.data() : nullptr, c.data());
+        for (std::size_t k = 0; k < n_c; ++k) values[k](i, j) = c[k];
+      }
+  } catch (const std::exception&) {
+    return {};  // a function that cannot be evaluated: no surfaces
+  }
+  for (std::size_t k = 0; k < n_c; ++k) {
+    auto seg = fesd::io_detail::zero_contour(values[k], xlo, xhi, ylo, yhi);
+    if (!seg.empty()) out.emplace_back("c[" + std::to_string(k) + "] = 0", std::move(seg));
+  }
+  return out;
+}
+
 /// The switching surfaces of a two-state model in the box [xlo, xhi] x [ylo, yhi], as the
-/// program's phase portrait draws them: (label, (k, 4) array of segments x0, y0, x1, y1) per
-/// surface; empty for other models.
-py::list switching_surfaces(const Problem& problem, double xlo, double xhi, double ylo,
-                            double yhi, int n_grid) {
-  const fesd::Pss& model = problem.model();
-  Eigen::VectorXd p = problem.is_ocp() ? std::get<fesd::OcpProblem>(problem.value).ocp.p
-                                       : std::get<fesd::SimulationProblem>(problem.value).p;
-  if (p.size() == 0) p = model.p_default;
+/// program's phase portrait draws them (a projected model: the boundary of C): (label, (k, 4)
+/// array of segments x0, y0, x1, y1) per surface; empty for other models.
+py::list switching_surfaces(const Problem& problem, double xlo, double xhi, double ylo, double yhi,
+                            int n_grid) {
+  const Surfaces surfaces = problem.visit(
+      [&](const auto& q) { return surfaces_of(model_of(q), p_of(q), xlo, xhi, ylo, yhi, n_grid); });
   py::list out;
-  for (const auto& [label, segments] :
-       fesd::io_detail::switching_surfaces(model, p, xlo, xhi, ylo, yhi, n_grid)) {
+  for (const auto& [label, segments] : surfaces) {
     py::array_t<double> a({static_cast<py::ssize_t>(segments.size()), py::ssize_t{4}});
     auto m = a.mutable_unchecked<2>();
     for (std::size_t i = 0; i < segments.size(); ++i) {
@@ -432,6 +541,9 @@ PYBIND11_MODULE(_fesd, m) {
           "kind", [](const Problem& p) { return p.is_ocp() ? "ocp" : "simulation"; },
           "\"simulation\" or \"ocp\".")
       .def_property_readonly(
+          "projected", &Problem::is_projected,
+          "True for a projected dynamical system ([model] kind = \"projected\", docs/pds.md).")
+      .def_property_readonly(
           "name", [](const Problem& p) { return p.visit([](const auto& q) { return q.name; }); },
           "The problem's `name`, or the file's stem.")
       .def_property_readonly(
@@ -443,19 +555,24 @@ PYBIND11_MODULE(_fesd, m) {
           [](const Problem& p) { return p.visit([](const auto& q) { return q.source; }); },
           "The file it was read from (or the name given for a dict).")
       .def_property_readonly(
-          "state_names", [](const Problem& p) { return state_names(p.model()); },
+          "state_names",
+          [](const Problem& p) {
+            return p.visit([](const auto& q) { return state_names(model_of(q)); });
+          },
           "Names of the states (a clock state \"t\" last if the model uses the time t).")
       .def_property_readonly(
-          "control_names", [](const Problem& p) { return control_names(p.model()); },
+          "control_names",
+          [](const Problem& p) {
+            return p.visit([](const auto& q) { return control_names(model_of(q)); });
+          },
           "Names of the controls.")
       .def_property_readonly(
           "parameters",
           [](const Problem& p) {
-            const Eigen::VectorXd values = p.is_ocp()
-                                               ? std::get<fesd::OcpProblem>(p.value).ocp.p
-                                               : std::get<fesd::SimulationProblem>(p.value).p;
+            const Eigen::VectorXd values = p.visit([](const auto& q) { return p_of(q); });
+            const std::vector<std::string> names =
+                p.visit([](const auto& q) { return model_of(q).parameter_names; });
             py::dict d;
-            const auto& names = p.model().parameter_names;
             for (Eigen::Index i = 0; i < values.size(); ++i) {
               const auto k = static_cast<std::size_t>(i);
               d[py::str(k < names.size() ? names[k] : numbered("p", static_cast<int>(i)))] =
@@ -467,13 +584,31 @@ PYBIND11_MODULE(_fesd, m) {
       .def_property_readonly(
           "x0",
           [](const Problem& p) {
-            return vector_array(p.is_ocp() ? std::get<fesd::OcpProblem>(p.value).ocp.x0
-                                           : std::get<fesd::SimulationProblem>(p.value).x0);
+            return vector_array(p.visit([](const auto& q) { return x0_of(q); }));
           },
           "The initial state (the guess of x0 for an OCP with a free x0).")
       .def_property_readonly(
-          "n_regions", [](const Problem& p) { return p.model().n_theta(); },
-          "Number of regions (rows of the stacked sign matrices).")
+          "n_regions",
+          [](const Problem& p) {
+            return p.is_projected() ? 0 : p.visit([](const auto& q) {
+              if constexpr (std::is_same_v<std::decay_t<decltype(q)>, fesd::PdsSimulationProblem>)
+                return 0;
+              else
+                return model_of(q).n_theta();
+            });
+          },
+          "Number of regions (rows of the stacked sign matrices); 0 for a projected model.")
+      .def_property_readonly(
+          "n_constraints",
+          [](const Problem& p) {
+            return p.visit([](const auto& q) {
+              if constexpr (std::is_same_v<std::decay_t<decltype(q)>, fesd::PdsSimulationProblem>)
+                return model_of(q).n_c();
+              else
+                return 0;
+            });
+          },
+          "Number of constraints c of a projected model (C = {x : c(x) >= 0}); 0 otherwise.")
       .def(py::pickle(&problem_state, &problem_from_state))
       .def("__repr__", [](const Problem& p) {
         return p.visit([&](const auto& q) {
@@ -485,6 +620,7 @@ PYBIND11_MODULE(_fesd, m) {
   m.def("_load", &load, py::arg("path"),
         "Reads a problem file (simulation or OCP); raises InputError on bad input.");
   m.def("_parse", &parse, py::arg("text"), py::arg("source_name"), py::arg("ocp"),
+        py::arg("projected") = false,
         "Reads a problem from TOML text; `source_name` is used in messages.");
   m.def("_with_overrides", &with_overrides, py::arg("problem"), py::arg("overrides"),
         "A copy of the problem with (key, value) overrides applied as the CLI applies them.");
