@@ -98,7 +98,7 @@ void table(const char* title, const std::vector<int>& n_s_list, const std::vecto
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<int> n_s_list{2, 3, 4}, nfe{10, 20, 40, 80, 140, 200, 400},
+  std::vector<int> n_s_list{1, 2, 3, 4}, nfe{10, 20, 40, 80, 140, 200, 400},
       nsim{5, 10, 20, 40, 70, 100, 200};
   for (int i = 1; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--ns"))

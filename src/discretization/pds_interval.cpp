@@ -98,12 +98,6 @@ std::vector<std::string> PdsInterval::errors(const Tableau& tab, const Discretiz
         "the trajectory, and where the state leaves the boundary of C, (8a) sets lambda = 0 "
         "there while c(x_{n,1}) < 0 (measured on Example 1: the homotopy stalls at a residual of "
         "5e-6); use radau_iia, or use_fesd = false");
-  if (o.use_fesd && tab.n_s < 2)
-    e.push_back(
-        "n_s = 1 with use_fesd: the step equilibration of papers/fesd-pds.txt Sect. III-C needs "
-        "n_s >= 2 (with one stage, (8b)/(8c) force c and lambda to 0 at the only stage next to a "
-        "switch, so nu_n = 0 there and the element lengths cannot move); use n_s >= 2 or "
-        "use_fesd = false");
   if (o.use_fesd && o.N_FE < 2)
     e.push_back(fmt::format("N_finite_elements = {}: FESD needs >= 2", o.N_FE));
   if (!(pds.M > 0) || !std::isfinite(pds.M))
@@ -192,6 +186,16 @@ void PdsInterval::build(nlp::BlockNlp& nlp, const PdsIntervalInputs& in) {
     auto row = [&](std::vector<int> vars, std::vector<double> a, double lb, double ub) {
       nlp.add_constraint(nlp::make_block(LinearEq{std::move(a)}), std::move(vars), lb, ub);
     };
+    // n_s = 1: c at the step start (the backward sum of boundary 1, see backward_extra).
+    C0_.clear();
+    if (n_s_ == 1) {
+      const int c0 = nlp.add_variables(n_c, -kInf, kInf, 0.0);
+      std::vector<int> cv = range(c0, n_c);
+      cv.insert(cv.end(), in.s0.begin(), in.s0.end());
+      cv.insert(cv.end(), in.p.begin(), in.p.end());
+      nlp.add_constraint(constraint, cv, 0.0, 0.0);
+      C0_ = range(c0, n_c);
+    }
     // z - sum of the stage values of element e >= 0 (one operand of "or").
     for (int n = 1; n < N_FE_; ++n) {
       for (int k = 0; k < n_c; ++k) {
@@ -211,10 +215,17 @@ void PdsInterval::build(nlp::BlockNlp& nlp, const PdsIntervalInputs& in) {
           for (int var : sum_vars(n - 1, of_lambda)) vb.push_back(var), vbf.push_back(var);
           for (int var : sum_vars(n, of_lambda)) vf.push_back(var), vbf.push_back(var);
           a.insert(a.end(), ones.begin(), ones.end());
-          row(vb, a, 0.0, kInf);
+          std::vector<double> ab = a, abf = a;
+          abf.insert(abf.end(), ones.begin(), ones.end());
+          if (const int extra = backward_extra(n, k, of_lambda); extra >= 0) {
+            vb.push_back(extra);
+            ab.push_back(-1.0);
+            vbf.push_back(extra);
+            abf.push_back(-1.0);
+          }
+          row(vb, ab, 0.0, kInf);
           row(vf, a, 0.0, kInf);
-          a.insert(a.end(), ones.begin(), ones.end());
-          row(vbf, a, -kInf, 0.0);
+          row(vbf, abf, -kInf, 0.0);
         }
         // nu_k = pi_c and pi_lambda: nu <= pi_c, nu <= pi_lambda, nu >= pi_c + pi_lambda - max,
         // max = max(pi_c, pi_lambda) = min z s.t. z >= pi_c, z >= pi_lambda by its KKT
@@ -314,6 +325,12 @@ void PdsInterval::set_guess(std::vector<double>& w, const Eigen::VectorXd& x0,
     }
   }
   if (nu_.empty() || !opt_.use_fesd) return;
+  if (!C0_.empty()) {
+    Eigen::VectorXd xs(n_x);
+    for (int j = 0; j < n_x; ++j) xs[j] = w[x(0, j)];
+    model_.functions().c(xs.data(), p.data(), c.data());
+    for (int k = 0; k < n_c; ++k) w[C0_[k]] = c[k];
+  }
   for (int n = 1; n < N_FE_; ++n) {
     double nu_max = 0;
     for (int k = 0; k < n_c; ++k) {
@@ -322,6 +339,8 @@ void PdsInterval::set_guess(std::vector<double>& w, const Eigen::VectorXd& x0,
         cb += w[C(n - 1, i, k)], cf += w[C(n, i, k)];
         lb += w[lambda(n - 1, i, k)], lf += w[lambda(n, i, k)];
       }
+      if (const int e = backward_extra(n, k, false); e >= 0) cb += w[e];
+      if (const int e = backward_extra(n, k, true); e >= 0) lb += w[e];
       const double pc = std::max(cb, cf), pl = std::max(lb, lf), mx = std::max(pc, pl);
       w[pi_c_[n][k]] = pc;
       w[pi_l_[n][k]] = pl;
@@ -337,12 +356,44 @@ void PdsInterval::set_guess(std::vector<double>& w, const Eigen::VectorXd& x0,
   }
 }
 
+int PdsInterval::backward_extra(int n, int k, bool of_lambda) const {
+  if (n_s_ != 1 || n < 1) return -1;
+  if (n >= 2) return of_lambda ? lambda(n - 2, 0, k) : C(n - 2, 0, k);
+  return of_lambda || C0_.empty() ? -1 : C0_[k];
+}
+
 std::vector<int> PdsInterval::active_set(const double* w, int n) const {
   std::vector<int> active;
   for (int k = 0; k < model_.n_c(); ++k) {
     double l = 0, c = 0;
     for (int i = 0; i < n_s_; ++i) l += w[lambda(n, i, k)], c += w[C(n, i, k)];
-    if (l > c) active.push_back(k);
+    if (n_s_ == 1 && opt_.use_fesd) {
+      if (one_stage_active(w, n, k)) active.push_back(k);
+    } else if (l > c) {
+      active.push_back(k);
+    }
+  }
+  return active;
+}
+
+bool PdsInterval::one_stage_active(const double* w, int n, int k) const {
+  // The last element of a contact (its end the leaving point) and the last one before a contact
+  // (its end the contact point) have lambda = c = 0 at their only stage ((8b), (8c)): such a tie
+  // continues the element before (in contact, resp. not), so that the switch is at its end.
+  // A tie: both factors below kTie of the larger neighbouring value of the same factor (in the
+  // relaxed solution they are O(complementarity_tol / the other factor), not exactly 0).
+  constexpr double kTie = 1e-3;
+  bool active = false;
+  for (int e = 0; e <= n; ++e) {
+    const double l = w[lambda(e, 0, k)], c = w[C(e, 0, k)];
+    double l_near = 0, c_near = 0;
+    for (int d : {e - 1, e + 1})
+      if (d >= 0 && d < N_FE_) {
+        l_near = std::max(l_near, w[lambda(d, 0, k)]);
+        c_near = std::max(c_near, w[C(d, 0, k)]);
+      }
+    const bool tie = e > 0 && l <= kTie * l_near && c <= kTie * c_near;
+    if (!tie) active = l > c;
   }
   return active;
 }

@@ -44,7 +44,7 @@ struct PdsIntervalInputs {
 class PdsInterval {
  public:
   /// Throws fesd::InvalidOption for a scheme without c_{n_s} = 1 and stiff accuracy (only Radau
-  /// IIA and Lobatto IIIC; FESD: Radau IIA only), FESD with n_s < 2 or N_FE < 2, or M <= 0.
+  /// IIA and Lobatto IIIC; FESD: Radau IIA only), FESD with N_FE < 2, or M <= 0.
   PdsInterval(const Pds& model, const Tableau& tableau, const DiscretizationOptions& options,
               const PdsOptions& pds_options);
 
@@ -94,6 +94,18 @@ class PdsInterval {
 
  private:
   int idx(int n, int i) const { return n * n_s_ + i; }
+  /// n_s = 1: one more term of the backward sums (10) of boundary n, else -1. With one stage the
+  /// paper's sigma^B of element n-1 is only its end point, where (8b)/(8c) make c = 0 at a
+  /// contact and lambda = 0 at a leaving point, so nu_n would be 0 exactly where the boundary must
+  /// move (Table I's + entries fail). The backward sums then also take the point before: c at the
+  /// element's start (C of element n-2's stage, or c(s0) for n = 1) and lambda of element n-2's
+  /// stage (none for n = 1). Table I holds again: at a contact c > 0 there (free flight before),
+  /// at a leaving point lambda > 0 there (contact before); where nothing switches the added term
+  /// is 0 exactly when the paper's is (docs/pds.md, "n_s = 1").
+  int backward_extra(int n, int k, bool of_lambda) const;
+  /// n_s = 1 with FESD: whether constraint k is active in element n (the rule of active_set, with
+  /// ties continuing the element before).
+  bool one_stage_active(const double* w, int n, int k) const;
 
   const Pds& model_;
   Tableau tab_;
@@ -102,6 +114,7 @@ class PdsInterval {
   PdsIntervalInputs in_;
   int N_FE_ = 0, n_s_ = 0;
   std::vector<int> h_, X_, V_, lambda_, C_;
+  std::vector<int> C0_;  ///< n_s = 1 with FESD: c(s0) (n_c variables), else empty
   // step equilibration, per boundary n (index n, 0 unused) and constraint k
   std::vector<int> nu_;
   std::vector<std::vector<int>> pi_c_, pi_l_, max_, nu_k_, s1_, s2_, mu1_, mu2_;

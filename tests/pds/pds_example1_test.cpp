@@ -100,6 +100,41 @@ TEST(PdsExample1Step, LeavingCloseToTheStepEnd) {
   EXPECT_NEAR(r.switches[0].t, a, 1e-12);
 }
 
+// FESD with one stage (Radau IIA n_s = 1, implicit Euler; the backward sums of the step
+// equilibration take the point before, docs/pds.md "n_s = 1"): order 1 like the standard method,
+// but the contact and leaving points are element boundaries and every other boundary keeps its
+// neighbours' length. Measured: error 0.258 (N_FE = 20), 0.141 (40): ratio 1.83; three distinct
+// h_n (before contact, sliding, after leaving).
+TEST(PdsExample1OneStage, SwitchesOnBoundariesAndEqualElementsBetween) {
+  double previous = 0;
+  for (int N_FE : {20, 40}) {
+    const auto r = fesd::integrate(example1(), x0(), kT, 1, options(1, N_FE, true));
+    ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+    EXPECT_LE(r.summary.max_comp_residual, 1e-9);
+    ASSERT_EQ(r.switches.size(), 2u);
+    // h_n changes only at the two switches (SwitchEvent::element: the element before it).
+    for (std::size_t n = 1; n < r.h.size(); ++n) {
+      const bool at_switch = static_cast<int>(n) - 1 == r.switches[0].element ||
+                             static_cast<int>(n) - 1 == r.switches[1].element;
+      if (!at_switch) {
+        EXPECT_NEAR(r.h[n], r.h[n - 1], 1e-7 * r.h[n]) << "n = " << n;
+      }
+    }
+    for (std::size_t n = 0; n < r.t.size(); ++n)
+      if (r.t[n] > r.switches[0].t + 1e-9 && r.t[n] < r.switches[1].t - 1e-9) {
+        EXPECT_NEAR(r.x[n][1], -1.0, 1e-9) << "t = " << r.t[n];
+      }
+    EXPECT_LT(std::abs(r.switches[0].t - kContact), 2.0 * kT / N_FE);
+    EXPECT_LT(std::abs(r.switches[1].t - kLeave), 2.0 * kT / N_FE);
+    EXPECT_LT(error(r), 2.0 * kT / N_FE);  // 1.12 h and 1.22 h measured
+    if (previous > 0) {
+      EXPECT_GT(previous / error(r), 1.5);
+      EXPECT_LT(previous / error(r), 2.5);
+    }
+    previous = error(r);
+  }
+}
+
 // Lobatto IIIC with the standard method (6): measured n_s = 3, N_FE = 10: 1.26e-2.
 TEST(PdsExample1Standard, LobattoIIIC) {
   const auto r =

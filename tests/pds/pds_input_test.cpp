@@ -79,14 +79,6 @@ TEST(PdsInput, FesdWithLobattoIIICRejected) {
   EXPECT_NE(m.find("lobatto_iiic with use_fesd"), std::string::npos) << m;
 }
 
-TEST(PdsInput, FesdWithOneStageRejected) {
-  fesd::IntegratorOptions o;
-  o.discretization.n_s = 1;
-  const std::string m = message_of<fesd::InvalidOption>(
-      [&] { fesd::integrate(half_plane(), Eigen::Vector2d(1.0, 1.0), 1.0, 1, o); });
-  EXPECT_NE(m.find("n_s = 1 with use_fesd"), std::string::npos) << m;
-}
-
 TEST(PdsInput, NonPositiveMRejected) {
   fesd::PdsOptions pds;
   pds.M = 0;
