@@ -89,6 +89,16 @@ struct Ocp {
   Eigen::VectorXd lbu, ubu;    ///< control bounds
   Eigen::VectorXd u_guess;     ///< initial guess of every control
   Eigen::VectorXd p;           ///< parameter values; empty: model.p_default
+  /// Time-varying parameters (nosnoc: p_time_var): N_stages vectors of n_p, the parameter values
+  /// of control interval k; empty: p in every interval. The Mayer term and the terminal
+  /// constraints use the last interval's values.
+  std::vector<Eigen::VectorXd> p_stage;
+  /// Initial guess of the controls per interval (N_stages vectors of n_u); empty: u_guess in
+  /// every interval.
+  std::vector<Eigen::VectorXd> u_guess_stage;
+  /// Initial guess of the states on the control grid t_k = k T / N_stages (N_stages + 1 vectors
+  /// of n_x; the first is the guess at t = 0), for OcpInitialization::External.
+  std::vector<Eigen::VectorXd> x_guess;
 
   int n_g_path = 0;  ///< number of path constraints g_path(x, u, p)
   Eigen::VectorXd lbg_path, ubg_path;
@@ -102,8 +112,12 @@ struct Ocp {
 enum class OcpInitialization {
   Constant,    ///< x0 at every point, algebraic variables from LP(x0) (the paper's Sect. 5.2)
   Simulation,  ///< a forward simulation from x0 with u_guess on the same grid (Sect. 4.5)
+  /// Ocp::x_guess, linear in t between the control grid points; per control interval the
+  /// algebraic variables from LP(x) at its midpoint (nosnoc: EXTERNAL). Picks a branch where
+  /// solutions are not unique, or starts from a known trajectory.
+  External,
 };
-/// Problem-file key `initialization`: "constant", "simulation".
+/// Problem-file key `initialization`: "constant", "simulation", "external".
 std::string_view to_string(OcpInitialization v);
 bool parse(std::string_view name, OcpInitialization& out);
 

@@ -446,7 +446,7 @@ void print_header(const fesd::OcpProblem& problem) {
   const fesd::OcpFunctions* f = ocp.functions.get();
   out::print("  ocp         T = {:g}, N_stages = {} (control interval {:g}), initialization = {}\n",
              ocp.T, ocp.N_stages, ocp.N_stages > 0 ? ocp.T / ocp.N_stages : 0.0,
-             o.initialization == fesd::OcpInitialization::Simulation ? "simulation" : "constant");
+             fesd::to_string(o.initialization));
   out::print("  cost        Lagrange term f_q: {}, Mayer term f_q_T: {}\n",
              f != nullptr && f->has_f_q() ? "yes" : "no",
              f != nullptr && f->has_f_q_T() ? "yes" : "no");

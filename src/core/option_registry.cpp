@@ -227,8 +227,15 @@ std::vector<Option> build() {
   o.push_back(input(kOcp, "lbu", ocp, "control lower bounds", "lbu"));
   o.push_back(input(kOcp, "ubu", ocp, "control upper bounds", "ubu"));
   o.push_back(input(kOcp, "u_guess", ocp,
-                    "initial guess of every control, one per control (comma-separated)", "u0",
-                    true));
+                    "initial guess of the controls: one per control (comma-separated), or in a "
+                    "file N_stages rows, one per control interval",
+                    "u0", true));
+  o.push_back(input(kOcp, "x_guess", ocp,
+                    "initial guess of the states at the control grid points t_k = k T / "
+                    "N_stages (N_stages + 1 rows); implies initialization = external",
+                    ""));
+  o.push_back(input(kOcp, "p_time_var", ocp,
+                    "parameters per control interval: {name = [N_stages values]}", "p_time_var"));
   o.push_back(input(kOcp, "lbx0", ocp, "lower bounds of a free initial state", ""));
   o.push_back(input(kOcp, "ubx0", ocp, "upper bounds of a free initial state", ""));
   with(scalar<&T::ocp, &Ocp::terminal_constraint>(

@@ -27,7 +27,7 @@ constexpr std::array<std::string_view, 5> kMpccMode{
     "scholtes_ineq", "scholtes_eq", "fischer_burmeister", "ell_1_penalty", "elastic_ineq"};
 // nosnoc's relax_terminal_constraint values that fesd implements.
 constexpr std::array<std::string_view, 2> kTerminalConstraint{"none", "ell_1"};
-constexpr std::array<std::string_view, 2> kOcpInitialization{"constant", "simulation"};
+constexpr std::array<std::string_view, 3> kOcpInitialization{"constant", "simulation", "external"};
 constexpr std::array<std::string_view, 4> kKktSolver{"auto", "sparse_ldl", "dense", "mumps"};
 constexpr std::array<std::string_view, 2> kStepSolver{"homotopy", "active_set"};
 

@@ -12,6 +12,7 @@
 #include <array>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <string>
@@ -108,7 +109,8 @@ void read_N_FE(const Reader& r, const toml::node& n, OcpProblem& problem) {
 /// The options of [ocp], [discretization], [homotopy] and [ipopt], then every input rule of the
 /// OCP (src/ocp/ocp_input.cpp): the problem's data first (ProblemFileError), then the options
 /// (InvalidOption), each message at the line of the key it names.
-void read_options(const Reader& r, const toml::table& root, OcpProblem& problem) {
+void read_options(const Reader& r, const toml::table& root, OcpProblem& problem,
+                  const std::function<void()>& read_stage_data) {
   const registry::OptionTarget target = target_of(problem);
   static constexpr std::array<std::string_view, 1> kPerInterval{"N_finite_elements"};
   for (registry::Table table : registry::tables(kKind)) {
@@ -120,9 +122,23 @@ void read_options(const Reader& r, const toml::table& root, OcpProblem& problem)
     if (table == registry::Table::Discretization)
       if (const toml::node* n = t.get(kPerInterval[0])) read_N_FE(r, *n, problem);
   }
+  read_stage_data();  // needs T and N_stages
   const ocp_detail::OcpInputErrors errors = ocp_detail::check_input(problem.ocp, problem.options);
   if (!errors.data.empty()) throw ProblemFileError(located(r, root, errors.data));
   if (!errors.options.empty()) throw_validation_errors(r, root, errors.options);
+}
+
+/// `u_guess`, `x_guess`: a vector, or (rows) an array of `n_rows` vectors of `n` numbers.
+std::vector<Eigen::VectorXd> read_rows(const Reader& r, const toml::node& n, std::string_view path,
+                                       int n_rows, std::string_view rows_what, int length,
+                                       std::string_view what) {
+  const toml::array& a = r.array(n, path, "an array of arrays of numbers");
+  if (static_cast<int>(a.size()) != n_rows)
+    r.fail(n.source(), path, fmt::format("{} rows, expected {} ({})", a.size(), n_rows, rows_what));
+  std::vector<Eigen::VectorXd> rows;
+  for (std::size_t k = 0; k < a.size(); ++k)
+    rows.push_back(r.vector(a[k], index(path, k), length, what));
+  return rows;
 }
 
 /// v with `value` appended (the clock's entry).
@@ -222,8 +238,6 @@ OcpProblem parse_ocp_problem(std::string_view toml_text, std::string_view source
     ocp.lbu = u.lb;
     ocp.ubu = u.ub;
   }
-  if (const toml::node* n = t.get("u_guess"))
-    ocp.u_guess = r.vector(*n, "ocp.u_guess", n_u, per_control);
   Bounds x0 = read_bounds(r, t, "lbx0", "ubx0", n_x_user, per_state);
   if (x0.lb_node != nullptr || x0.ub_node != nullptr) {
     complete_bounds(x0, n_x_user, -kInf, kInf);
@@ -243,7 +257,48 @@ OcpProblem parse_ocp_problem(std::string_view toml_text, std::string_view source
   ocp.lbg_terminal = gt.lb;
   ocp.ubg_terminal = gt.ub;
 
-  read_options(r, root, problem);
+  // Guesses and parameters per control interval: read once T and N_stages are known.
+  const auto read_stage_data = [&] {
+    if (const toml::node* n = t.get("u_guess")) {
+      const toml::array* a = n->as_array();
+      if (a != nullptr && !a->empty() && (*a)[0].is_array())  // one row per control interval
+        ocp.u_guess_stage = read_rows(r, *n, "ocp.u_guess", ocp.N_stages,
+                                      "one per control interval, N_stages", n_u, per_control);
+      else
+        ocp.u_guess = r.vector(*n, "ocp.u_guess", n_u, per_control);
+    }
+    if (const toml::node* n = t.get("x_guess")) {
+      // The states at t_k = k T / N_stages; the clock's guess is t_k itself.
+      ocp.x_guess = read_rows(r, *n, "ocp.x_guess", ocp.N_stages + 1,
+                              "one per control grid point t_k = k T / N_stages, k = 0..N_stages",
+                              n_x_user, per_state);
+      if (has_clock)
+        for (std::size_t k = 0; k < ocp.x_guess.size(); ++k)
+          ocp.x_guess[k] = append(ocp.x_guess[k], static_cast<double>(k) * ocp.T / ocp.N_stages);
+      // A guess of the states means initialization = external unless the file says otherwise.
+      if (t.get("initialization") == nullptr)
+        problem.options.initialization = OcpInitialization::External;
+    }
+    if (const toml::node* n = t.get("p_time_var")) {
+      // {name = [one value per control interval]}: those parameters per interval, the others as
+      // in [model] p.
+      const toml::table& pt = r.table(*n, "ocp.p_time_var");
+      ocp.p_stage.assign(static_cast<std::size_t>(ocp.N_stages), ocp.p);
+      for (const auto& [key, value] : pt) {
+        const std::string name(key.str());
+        const std::string path = "ocp.p_time_var." + name;
+        const auto it = std::find(sym.p.begin(), sym.p.end(), name);
+        if (it == sym.p.end())
+          r.fail(value.source(), path,
+                 fmt::format("unknown parameter '{}' (expected a name of [model] p)", name));
+        const Eigen::VectorXd v =
+            r.vector(value, path, ocp.N_stages, "one value per control interval, N_stages");
+        const auto i = static_cast<Eigen::Index>(it - sym.p.begin());
+        for (int k = 0; k < ocp.N_stages; ++k) ocp.p_stage[static_cast<std::size_t>(k)][i] = v[k];
+      }
+    }
+  };
+  read_options(r, root, problem, read_stage_data);
   return problem;
 }
 
@@ -265,6 +320,7 @@ void apply_override(OcpProblem& problem, std::string_view key, std::string_view 
   } else if (arg.option != nullptr && arg.option->key == "u_guess") {
     updated.ocp.u_guess = override_vector(arg.head, arg.value, updated.ocp.model.n_u(),
                                           "ocp.u_guess", "one per control in model.u");
+    updated.ocp.u_guess_stage.clear();  // one guess for every interval now
   } else if (set_model_override(arg, updated.ocp.model, updated.has_clock, updated.ocp.x0,
                                 updated.ocp.p)) {
     // [model] x0 (the guess of a free x0) or one parameter

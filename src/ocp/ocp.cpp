@@ -40,6 +40,21 @@ using discretization::FesdInterval;
 using discretization::IntervalInputs;
 using nlp::kInf;
 
+/// The parameter values of every control interval (Ocp::p_stage, or p in each).
+using StageParameters = std::vector<Eigen::VectorXd>;
+
+StageParameters stage_parameters(const Ocp& ocp) {
+  if (!ocp.p_stage.empty()) return ocp.p_stage;
+  return StageParameters(static_cast<std::size_t>(ocp.N_stages),
+                         ocp.p.size() > 0 ? ocp.p : ocp.model.p_default);
+}
+
+/// The control guess of interval k (Ocp::u_guess_stage, u_guess, or 0).
+Eigen::VectorXd control_guess(const Ocp& ocp, int k) {
+  if (!ocp.u_guess_stage.empty()) return ocp.u_guess_stage[static_cast<std::size_t>(k)];
+  return ocp.u_guess.size() > 0 ? ocp.u_guess : Eigen::VectorXd::Zero(ocp.model.n_u());
+}
+
 std::vector<int> range(int first, int n) {
   std::vector<int> r(n);
   for (int i = 0; i < n; ++i) r[i] = first + i;
@@ -133,13 +148,14 @@ struct OcpNlp {
   mpcc::Problem mpcc;
   Tableau tab;
   std::vector<int> s0, p;
-  std::vector<std::vector<int>> q;  // per interval
+  std::vector<std::vector<int>> p_k;  // per interval: p, or its own fixed values (p_stage)
+  std::vector<std::vector<int>> q;    // per interval
   std::vector<std::unique_ptr<FesdInterval>> iv;
   std::vector<IntervalInputs> in;
   std::vector<int> terminal_slacks;
 };
 
-std::unique_ptr<OcpNlp> build(const Ocp& ocp, const OcpOptions& o, const Eigen::VectorXd& p) {
+std::unique_ptr<OcpNlp> build(const Ocp& ocp, const OcpOptions& o, const StageParameters& p) {
   const Pss& m = ocp.model;
   const DiscretizationOptions& d = o.discretization;
   const int n_x = m.n_x(), n_u = m.n_u(), n_p = m.n_p(), n_th = m.n_theta(), n_sys = m.n_sys();
@@ -157,7 +173,15 @@ std::unique_ptr<OcpNlp> build(const Ocp& ocp, const OcpOptions& o, const Eigen::
       mp.bound(b->s0[i], std::max(lower(ocp.lbx0, i), lower(ocp.lbx, i)),
                std::min(upper(ocp.ubx0, i), upper(ocp.ubx, i)));
   b->p = range(nlp.add_variables(n_p, 0.0, 0.0, 0.0), n_p);
-  mp.fix(b->p, p);
+  mp.fix(b->p, p.front());
+  for (int k = 0; k < ocp.N_stages; ++k) {
+    if (k == 0 || ocp.p_stage.empty()) {
+      b->p_k.push_back(b->p);
+    } else {
+      b->p_k.push_back(range(nlp.add_variables(n_p, 0.0, 0.0, 0.0), n_p));
+      mp.fix(b->p_k.back(), p[static_cast<std::size_t>(k)]);
+    }
+  }
   // The standard method does not use lambda_{0,0}: fixed dummies.
   std::vector<int> dummy_lambda, dummy_mu;
   if (!d.use_fesd) {
@@ -169,15 +193,15 @@ std::unique_ptr<OcpNlp> build(const Ocp& ocp, const OcpOptions& o, const Eigen::
   const double T_k = ocp.T / ocp.N_stages;
   for (int k = 0; k < ocp.N_stages; ++k) {
     std::vector<int> q = range(nlp.add_variables(n_u, 0.0, 0.0, 0.0), n_u);
+    const Eigen::VectorXd u_guess = control_guess(ocp, k);
     for (int i = 0; i < n_u; ++i) {
       mp.bound(q[i], lower(ocp.lbu, i), upper(ocp.ubu, i));
-      const double g = ocp.u_guess.size() > 0 ? ocp.u_guess[i] : 0.0;
-      mp.guess()[q[i]] = std::clamp(g, mp.lower(q[i]), mp.upper(q[i]));
+      mp.guess()[q[i]] = std::clamp(u_guess[i], mp.lower(q[i]), mp.upper(q[i]));
     }
     b->q.push_back(q);
     IntervalInputs in;
     in.q = q;
-    in.p = b->p;
+    in.p = b->p_k[k];
     in.T = T_k;
     in.boundary_at_end = true;  // non-stiffly-accurate schemes: lambda at s_{k+1} for the next
     if (k == 0) {
@@ -226,30 +250,30 @@ std::unique_ptr<OcpNlp> build(const Ocp& ocp, const OcpOptions& o, const Eigen::
       mp.bound(first + i, std::max(mp.lower(first + i), lower(ocp.lbx, i)),
                std::min(mp.upper(first + i), upper(ocp.ubx, i)));
   };
-  auto add_path = [&](int x_first, const std::vector<int>& q) {
+  auto add_path = [&](int x_first, const std::vector<int>& q, const std::vector<int>& pk) {
     if (!path) return;
     std::vector<int> vars = range(x_first, n_x);
     vars.insert(vars.end(), q.begin(), q.end());
-    vars.insert(vars.end(), b->p.begin(), b->p.end());
+    vars.insert(vars.end(), pk.begin(), pk.end());
     nlp.add_constraint(path, vars, path_lb, path_ub);
   };
-  add_path(b->s0[0], b->q[0]);
+  add_path(b->s0[0], b->q[0], b->p_k[0]);
   for (int k = 0; k < ocp.N_stages; ++k) {
     const FesdInterval& iv = *b->iv[k];
     for (int n = 0; n < iv.N_FE(); ++n) {
       bound_state(iv.x(n + 1, 0));
-      add_path(iv.x(n + 1, 0), b->q[k]);
+      add_path(iv.x(n + 1, 0), b->q[k], b->p_k[k]);
       if (o.constraints_at_stages)
         for (int s = 0; s < iv.n_s(); ++s) {
           bound_state(iv.X(n, s, 0));
-          add_path(iv.X(n, s, 0), b->q[k]);
+          add_path(iv.X(n, s, 0), b->q[k], b->p_k[k]);
         }
       if (lagrange) {
         std::vector<int> vars{iv.h(n)};
         for (int s = 0; s < iv.n_s(); ++s)
           for (int i = 0; i < n_x; ++i) vars.push_back(iv.X(n, s, i));
         vars.insert(vars.end(), b->q[k].begin(), b->q[k].end());
-        vars.insert(vars.end(), b->p.begin(), b->p.end());
+        vars.insert(vars.end(), b->p_k[k].begin(), b->p_k[k].end());
         nlp.add_objective(lagrange, vars);
       }
     }
@@ -258,7 +282,7 @@ std::unique_ptr<OcpNlp> build(const Ocp& ocp, const OcpOptions& o, const Eigen::
   // ---- terminal cost and constraints at s_N ----
   const FesdInterval& last = *b->iv.back();
   std::vector<int> xp = range(last.x(last.N_FE(), 0), n_x);
-  xp.insert(xp.end(), b->p.begin(), b->p.end());
+  xp.insert(xp.end(), b->p_k.back().begin(), b->p_k.back().end());
   if (f && f->has_f_q_T()) nlp.add_objective(nlp::make_block(MayerTerm{f, n_x, n_p}), xp);
   if (ocp.n_g_terminal > 0) {
     const int n_g = ocp.n_g_terminal;
@@ -292,12 +316,14 @@ std::unique_ptr<OcpNlp> build(const Ocp& ocp, const OcpOptions& o, const Eigen::
 
 // ---- initial guess -----------------------------------------------------------------------------
 
-/// Constant: x0 everywhere, algebraic variables from LP(x0) (Sect. 5.2).
-void guess_constant(OcpNlp& b, const Ocp& ocp, const Eigen::VectorXd& p) {
-  const dcs::LpSolution lp = dcs::solve_lp(ocp.model, ocp.x0, p);
+/// Constant: x0 everywhere, algebraic variables from LP(x0) (Sect. 5.2), with each interval's
+/// parameters.
+void guess_constant(OcpNlp& b, const Ocp& ocp, const StageParameters& p) {
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(ocp.model.n_x());
   auto& w = b.mpcc.guess();
-  for (const auto& iv : b.iv) iv->set_guess(w, ocp.x0, lp, zero);
+  for (std::size_t k = 0; k < b.iv.size(); ++k)
+    b.iv[k]->set_guess(w, ocp.x0, dcs::solve_lp(ocp.model, ocp.x0, p[k]), zero);
+  const dcs::LpSolution lp = dcs::solve_lp(ocp.model, ocp.x0, p.front());
   const auto& in0 = b.in.front();
   if (in0.lp_at_start) {
     for (int r = 0; r < ocp.model.n_theta(); ++r) w[in0.lambda_start[r]] = lp.lambda[r];
@@ -306,10 +332,33 @@ void guess_constant(OcpNlp& b, const Ocp& ocp, const Eigen::VectorXd& p) {
   for (int i = 0; i < ocp.model.n_x(); ++i) w[b.s0[i]] = ocp.x0[i];
 }
 
+/// External: Ocp::x_guess, linear in t on each control interval, the algebraic variables of
+/// interval k from LP at its midpoint with its parameters. x0 keeps its value unless it is free.
+void guess_external(OcpNlp& b, const Ocp& ocp, const StageParameters& p) {
+  const Pss& m = ocp.model;
+  auto& w = b.mpcc.guess();
+  const double T_k = ocp.T / ocp.N_stages;
+  for (std::size_t k = 0; k < b.iv.size(); ++k) {
+    const Eigen::VectorXd& a = ocp.x_guess[k];
+    const Eigen::VectorXd& e = ocp.x_guess[k + 1];
+    b.iv[k]->set_guess(w, a, dcs::solve_lp(m, 0.5 * (a + e), p[k]), (e - a) / T_k);
+  }
+  const Eigen::VectorXd start = ocp.lbx0.size() > 0 ? ocp.x_guess.front() : ocp.x0;
+  for (int i = 0; i < m.n_x(); ++i)
+    w[b.s0[i]] = std::clamp(start[i], b.mpcc.lower(b.s0[i]), b.mpcc.upper(b.s0[i]));
+  const auto& in0 = b.in.front();
+  if (in0.lp_at_start) {
+    const dcs::LpSolution lp = dcs::solve_lp(m, start, p.front());
+    for (int r = 0; r < m.n_theta(); ++r) w[in0.lambda_start[r]] = lp.lambda[r];
+    for (int j = 0; j < m.n_sys(); ++j) w[in0.mu_start[j]] = lp.mu[j];
+  }
+  for (const auto& iv : b.iv) iv->update_lifted_guess(w);
+}
+
 /// Simulation: the FESD integrator from x0 with u_guess on the same grid (one integration step
 /// per control interval). Falls back to the constant guess (returns false) if the integrator
 /// fails or its grid differs (split steps, different N_FE per interval).
-bool guess_simulation(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Eigen::VectorXd& p) {
+bool guess_simulation(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const StageParameters& p) {
   const Pss& m = ocp.model;
   const std::vector<int> N_FE = intervals_N_FE(ocp, o);
   for (int n : N_FE)
@@ -327,23 +376,43 @@ bool guess_simulation(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Eige
   io.homotopy.complementarity_tol = o.homotopy.complementarity_tol;
   io.nlp = o.nlp;
   io.nlp.print_level = 0;
-  const Eigen::VectorXd u = ocp.u_guess.size() > 0 ? ocp.u_guess : Eigen::VectorXd::Zero(m.n_u());
-  const IntegratorResult r = integrate(m, ocp.x0, ocp.T, ocp.N_stages, io, u, p);
+  // One integration step per control interval: in one run when every interval has the same
+  // control guess and parameters, else interval by interval (each from the previous end).
+  IntegratorResult r;
+  if (ocp.p_stage.empty() && ocp.u_guess_stage.empty()) {
+    r = integrate(m, ocp.x0, ocp.T, ocp.N_stages, io, control_guess(ocp, 0), p.front());
+  } else {
+    r.x = {ocp.x0};
+    r.status = Status::Success;
+    for (int k = 0; k < ocp.N_stages && r.status == Status::Success; ++k) {
+      const IntegratorResult rk = integrate(m, r.x.back(), ocp.T / ocp.N_stages, 1, io,
+                                            control_guess(ocp, k), p[static_cast<std::size_t>(k)]);
+      r.status = rk.status;
+      if (rk.status != Status::Success || rk.x.empty()) break;
+      r.h.insert(r.h.end(), rk.h.begin(), rk.h.end());
+      r.x.insert(r.x.end(), rk.x.begin() + 1, rk.x.end());
+      for (auto [to, from] : {std::pair{&r.x_stage, &rk.x_stage}, std::pair{&r.theta, &rk.theta},
+                              std::pair{&r.lambda, &rk.lambda}, std::pair{&r.mu, &rk.mu}})
+        to->insert(to->end(), from->begin(), from->end());
+    }
+  }
   const int n_s = b.tab.n_s, n_x = m.n_x(), n_th = m.n_theta(), n_sys = m.n_sys();
   const std::size_t elements = static_cast<std::size_t>(N_FE.front() * ocp.N_stages);
   if (r.status != Status::Success || r.h.size() != elements) return false;
   guess_constant(b, ocp, p);  // everything the simulation does not give
   auto& w = b.mpcc.guess();
   int e = 0;
-  for (const auto& ivp : b.iv) {
-    const FesdInterval& iv = *ivp;
+  for (std::size_t iv_k = 0; iv_k < b.iv.size(); ++iv_k) {
+    const FesdInterval& iv = *b.iv[iv_k];
+    const Eigen::VectorXd u = control_guess(ocp, static_cast<int>(iv_k));
+    const Eigen::VectorXd& pk = p[iv_k];
     for (int n = 0; n < iv.N_FE(); ++n, ++e) {
       w[iv.h(n)] = std::clamp(r.h[e], b.mpcc.lower(iv.h(n)), b.mpcc.upper(iv.h(n)));
       for (int i = 0; i < n_x; ++i) w[iv.x(n + 1, i)] = r.x[e + 1][i];
       for (int s = 0; s < n_s; ++s) {
         const std::size_t st = static_cast<std::size_t>(e * n_s + s);
         Eigen::VectorXd V(n_x);
-        dcs::eval_F_theta<double>(m, r.x_stage[st].data(), u.data(), p.data(), r.theta[st].data(),
+        dcs::eval_F_theta<double>(m, r.x_stage[st].data(), u.data(), pk.data(), r.theta[st].data(),
                                   V.data());
         for (int i = 0; i < n_x; ++i) {
           w[iv.X(n, s, i)] = r.x_stage[st][i];
@@ -356,7 +425,7 @@ bool guess_simulation(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Eige
         for (int j = 0; j < n_sys; ++j) w[iv.mu(n, s, j)] = r.mu[st][j];
       }
       if (iv.lambda_end(n, 0) >= 0 && !(iv.lambda_end(n, 0) == iv.lambda(n, n_s - 1, 0))) {
-        const dcs::LpSolution lp = dcs::solve_lp(m, r.x[e + 1], p);
+        const dcs::LpSolution lp = dcs::solve_lp(m, r.x[e + 1], pk);
         for (int k = 0; k < n_th; ++k) w[iv.lambda_end(n, k)] = lp.lambda[k];
         for (int j = 0; j < n_sys; ++j) w[iv.mu_end(n, j)] = lp.mu[j];
       }
@@ -369,7 +438,7 @@ bool guess_simulation(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Eige
 // ---- results -----------------------------------------------------------------------------------
 
 void extract(const OcpNlp& b, const Ocp& ocp, const std::vector<double>& w,
-             const Eigen::VectorXd& p, OcpResult& res) {
+             const StageParameters& p, OcpResult& res) {
   const Pss& m = ocp.model;
   const int n_x = m.n_x(), n_th = m.n_theta(), n_u = m.n_u();
   const double T_k = ocp.T / ocp.N_stages;
@@ -394,7 +463,7 @@ void extract(const OcpNlp& b, const Ocp& ocp, const std::vector<double>& w,
         res.x_stage.push_back(X);
         res.theta.push_back(gather(w, iv.theta(n, s, 0), n_th));
         res.lambda.push_back(gather(w, iv.lambda(n, s, 0), n_th));
-        if (f && f->has_f_q()) quad += b.tab.b(s) * f->f_q(X.data(), q.data(), p.data());
+        if (f && f->has_f_q()) quad += b.tab.b(s) * f->f_q(X.data(), q.data(), p[k].data());
       }
       objective += hn * quad;
       if (!res.active_set.empty() && res.active_set.back() != active)
@@ -410,14 +479,14 @@ void extract(const OcpNlp& b, const Ocp& ocp, const std::vector<double>& w,
     }
   }
   res.t_ctrl.push_back(ocp.T);
-  if (f && f->has_f_q_T()) objective += f->f_q_T(res.x.back().data(), p.data());
+  if (f && f->has_f_q_T()) objective += f->f_q_T(res.x.back().data(), p.back().data());
   for (int s : b.terminal_slacks) objective += ocp.rho_terminal * w[s];
   res.objective = objective;
 }
 
 /// The OCP's own cost (59a) at the NLP point w.
 double cost(const OcpNlp& b, const Ocp& ocp, const std::vector<double>& w,
-            const Eigen::VectorXd& p) {
+            const StageParameters& p) {
   OcpResult r;
   extract(b, ocp, w, p, r);
   return r.objective;
@@ -487,7 +556,7 @@ std::function<bool(mpcc::HomotopyResult&)> early_active_set_finish(OcpNlp& b, co
 /// Solves the last NLP once more from `start` with `bounds` (active sets fixed). The result is
 /// kept if it converges and keep(its cost) holds; else the point before is restored.
 template <class Account, class Keep>
-bool try_resolve(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Eigen::VectorXd& p,
+bool try_resolve(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const StageParameters& p,
                  nlp::NlpSolver& solver, const Account& account, mpcc::HomotopyResult& hr,
                  const std::vector<double>& start, const std::vector<nlp::Bound>& bounds,
                  int n_pins, const Keep& keep) {
@@ -512,7 +581,7 @@ bool try_resolve(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Eigen::Ve
 /// kMaxGridMoves rounds (each one at least doubles how far a held switch can go). Switches still
 /// held at the end are counted and named in a warning.
 template <class Account>
-void move_held_switches(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Eigen::VectorXd& p,
+void move_held_switches(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const StageParameters& p,
                         nlp::NlpSolver& solver, const Account& account, mpcc::HomotopyResult& hr,
                         Summary& summary) {
   constexpr int kMaxGridMoves = 8;
@@ -543,7 +612,7 @@ void move_held_switches(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Ei
 /// every active set fixed; kept if the cost falls, then held switches are moved again. At most
 /// kMaxProbes NLPs.
 template <class Account>
-void probe_touches(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Eigen::VectorXd& p,
+void probe_touches(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const StageParameters& p,
                    nlp::NlpSolver& solver, const Account& account, mpcc::HomotopyResult& hr,
                    Summary& summary) {
   constexpr int kMaxProbes = 4;
@@ -583,7 +652,7 @@ void probe_touches(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Eigen::
 /// lower, or if the regrid had to move the switch (an h bound). Kept (true) if it converges and
 /// lowers the cost.
 template <class Account>
-bool try_allocation_move(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Eigen::VectorXd& p,
+bool try_allocation_move(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const StageParameters& p,
                          nlp::NlpSolver& solver, const Account& account, mpcc::HomotopyResult& hr,
                          std::size_t k, std::size_t j, const std::vector<int>& count,
                          Summary& summary) {
@@ -621,7 +690,7 @@ bool try_allocation_move(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const E
 /// for the problem costs none. Only with step_eq = l2_relaxed: the other penalties pull every h_n
 /// to h0 (heuristic_*) and so decide the allocation themselves, or are not the default.
 template <class Account>
-void search_allocation(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Eigen::VectorXd& p,
+void search_allocation(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const StageParameters& p,
                        nlp::NlpSolver& solver, const Account& account, mpcc::HomotopyResult& hr,
                        Summary& summary) {
   if (o.discretization.step_eq != StepEq::L2Relaxed) return;
@@ -679,7 +748,7 @@ void search_allocation(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Eig
 /// the last NLP with every active set fixed; the result kept whatever its cost. False (the point
 /// before restored) if an interval cannot be re-gridded or the re-solve fails.
 template <class Account>
-bool force_allocation(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Eigen::VectorXd& p,
+bool force_allocation(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const StageParameters& p,
                       nlp::NlpSolver& solver, const Account& account, mpcc::HomotopyResult& hr,
                       const std::vector<int>& count, Summary& summary) {
   const std::vector<double> w = b.mpcc.solution();
@@ -777,8 +846,8 @@ namespace {
 OcpResult solve_impl(const Ocp& ocp, const OcpOptions& options, const std::vector<int>* count,
                      bool* applied) {
   const auto t_start = Clock::now();
-  ocp_detail::require_valid_input(ocp, options);  // src/ocp/ocp_input.cpp, shared with files
-  const Eigen::VectorXd p = ocp.p.size() > 0 ? ocp.p : ocp.model.p_default;  // n_p checked
+  ocp_detail::require_valid_input(ocp, options);    // src/ocp/ocp_input.cpp, shared with files
+  const StageParameters p = stage_parameters(ocp);  // sizes checked
 
   std::unique_ptr<OcpNlp> b = build(ocp, options, p);
   mpcc::Problem& mp = b->mpcc;
@@ -787,7 +856,10 @@ OcpResult solve_impl(const Ocp& ocp, const OcpOptions& options, const std::vecto
   bool simulated = false;
   if (options.initialization == OcpInitialization::Simulation)
     simulated = guess_simulation(*b, ocp, options, p);
-  if (!simulated) guess_constant(*b, ocp, p);
+  if (options.initialization == OcpInitialization::External)
+    guess_external(*b, ocp, p);
+  else if (!simulated)
+    guess_constant(*b, ocp, p);
   mp.finalize();
   res.summary.warnings = warnings(options.homotopy);
   res.summary.n_variables = mp.num_variables();

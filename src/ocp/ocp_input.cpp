@@ -120,6 +120,33 @@ void check_data(std::vector<std::string>& e, const Ocp& ocp) {
                  "satisfy its bounds");
   check_vector(e, ocp.p.size() > 0 ? ocp.p : m.p_default, m.n_p(), "model.p", "one per parameter",
                false);
+  // Per control interval / control grid point: N_stages (+ 1) vectors.
+  const auto check_rows = [&](const std::vector<Eigen::VectorXd>& rows, int expected,
+                              std::string_view path, std::string_view rows_what, Eigen::Index n,
+                              std::string_view what, auto&& each) {
+    if (rows.empty()) return;
+    if (static_cast<int>(rows.size()) != expected) {
+      e.push_back(
+          fmt::format("{}: {} rows, expected {} ({})", path, rows.size(), expected, rows_what));
+      return;
+    }
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+      const std::string row = fmt::format("{}[{}]", path, k);
+      if (check_vector(e, rows[k], n, row, what, false)) each(rows[k], row);
+    }
+  };
+  const auto nothing = [](const Eigen::VectorXd&, const std::string&) {};
+  check_rows(ocp.p_stage, ocp.N_stages, "ocp.p_stage", "one per control interval (N_stages)",
+             m.n_p(), "one per parameter", nothing);
+  check_rows(ocp.u_guess_stage, ocp.N_stages, "ocp.u_guess", "one per control interval (N_stages)",
+             n_u, "one per control", [&](const Eigen::VectorXd& v, const std::string& row) {
+               if (u_bounds_ok)
+                 check_within(e, v, ocp.lbu, ocp.ubu, row, "lbu, ubu",
+                              "expected a guess within the control bounds");
+             });
+  check_rows(ocp.x_guess, ocp.N_stages + 1, "ocp.x_guess",
+             "one per control grid point t_k = k T / N_stages, k = 0..N_stages", n_x,
+             "one per state", nothing);
   if (ocp.n_g_path < 0) e.push_back(fmt::format("ocp.n_g_path = {}: must be >= 0", ocp.n_g_path));
   if (ocp.n_g_terminal < 0)
     e.push_back(fmt::format("ocp.n_g_terminal = {}: must be >= 0", ocp.n_g_terminal));
@@ -143,6 +170,15 @@ OcpInputErrors check_input(const Ocp& ocp, const OcpOptions& options) {
   if (e.options.empty())  // the smallest control interval, docs/problem-files.md "Limits"
     if (std::string s = step_length_error(ocp); !s.empty()) e.options.push_back(std::move(s));
   check_data(e.data, ocp);
+  const bool external = options.initialization == OcpInitialization::External;
+  if (external && ocp.x_guess.empty())
+    e.options.push_back(
+        "ocp.initialization = external: needs x_guess (the states at the control grid points)");
+  if (!external && !ocp.x_guess.empty())
+    e.options.push_back(
+        fmt::format("ocp.initialization = {}: x_guess is given but used only with initialization = "
+                    "external",
+                    to_string(options.initialization)));
   if (e.options.empty() && e.data.empty())  // the limits of the NLP's blocks
     e.data = block_size_errors(ocp, options);
   return e;
