@@ -584,8 +584,9 @@ class Integrator {
   /// sensitivities there, D <- J D with J = I + (f_j - f_i) grad psi' / (grad psi' f_i),
   /// psi = g_i - g_j, for the region i of the element before and j of the first element (one
   /// region of one subsystem replaced by one other; the crossing transversal: grad psi' f_i > 0).
-  /// Then check_single_changes() accepts the switch there. A sliding entry or exit on a step
-  /// boundary (f* of Prop. 9's remark) is not done: not available, as before.
+  /// A sliding entry (j joins the one region i of its subsystem; grad psi' f_j < 0) the same with
+  /// f_j replaced by the sliding field f* (Prop. 9's remark). Then check_single_changes() accepts
+  /// the switch there. A sliding exit on a step boundary is not done: not available, as before.
   void jump_at_step_start(const discretization::FesdInterval& iv, const std::vector<double>& w) {
     jump_at_start_ = false;
     if (!res_.sensitivities.available || res_.active_set.empty()) return;
@@ -593,6 +594,7 @@ class Integrator {
     const std::vector<int> after = iv.active_set(w.data(), 0);
     if (after == before) return;
     int i = -1, j = -1;
+    bool sliding = false;  // j joins i: a sliding entry (f* for f_j)
     for (int k = 0; k < model_.n_sys(); ++k) {
       const int first = model_.region_offset(k), end = model_.region_offset(k + 1);
       std::vector<int> b, a;
@@ -601,9 +603,16 @@ class Integrator {
       for (int r : after)
         if (r >= first && r < end) a.push_back(r);
       if (a == b) continue;
-      if (a.size() != 1 || b.size() != 1 || i >= 0) return;  // not a single crossing
+      if (b.size() != 1 || i >= 0) return;  // not a single switch out of one region
       i = b[0];
-      j = a[0];
+      if (a.size() == 1) {
+        j = a[0];
+      } else if (a.size() == 2 && (a[0] == i || a[1] == i)) {
+        j = a[0] == i ? a[1] : a[0];
+        sliding = true;
+      } else {
+        return;
+      }
     }
     constexpr int kMaxJet = 128;
     const int n_x = model_.n_x();
@@ -620,6 +629,13 @@ class Integrator {
     model_.functions().f(j, x_.data(), u_.data(), p_.data(), f_j.data());
     const double normal = grad.dot(f_i);
     if (!(normal > 1e-12 * grad.norm() * f_i.norm()) || !std::isfinite(normal)) return;
+    if (sliding) {
+      // Prop. 9's remark: f_j replaced by the sliding field f* = f_i + theta_j (f_j - f_i) with
+      // grad psi' f* = 0; an attracting surface: grad psi' f_j < 0, so theta_j in (0, 1).
+      const double normal_j = grad.dot(f_j);
+      if (!(normal_j < -1e-12 * grad.norm() * f_j.norm()) || !std::isfinite(normal_j)) return;
+      f_j = f_i + normal / (normal - normal_j) * (f_j - f_i);
+    }
     const Eigen::MatrixXd J =
         Eigen::MatrixXd::Identity(n_x, n_x) + (f_j - f_i) * grad.transpose() / normal;
     Sensitivities& sens = res_.sensitivities;

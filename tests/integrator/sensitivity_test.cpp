@@ -15,6 +15,7 @@
 #include "fesd/integrator.hpp"
 #include "fesd/model.hpp"
 #include "fesd/problem_file.hpp"
+#include "integrator/stepper_models.hpp"
 
 namespace {
 
@@ -130,19 +131,41 @@ TEST_P(IftSliding, IsZeroAfterSliding) {
 }
 
 // A sliding entry exactly on a step boundary (a fixed time, not a free element boundary: the IFT
-// cannot move it) is outside Thm 19's setting: not available, with the reason. Example 3(b) with
-// x0 = 0.5, N_sim = 10 (the entry at t = 0.5; before this check Radau IIA gave 0 by R(inf) = 0 and
+// cannot move it) gets the jump (24) with the sliding field f* (Prop. 9's remark): Example 3(b)
+// with x0 = 0.5, N_sim = 10 (the entry at t = 0.5): J = 1 + (0 - (-1)) / (-1) = 0, so 0 exactly
+// (before the jump: not available; before that check Radau IIA gave 0 by R(inf) = 0 and
 // Gauss-Legendre 1).
-TEST_P(IftSliding, SlidingEntryOnAStepBoundaryIsNotAvailable) {
+TEST_P(IftSliding, SlidingEntryOnAStepBoundaryHasTheJump) {
   const Case c = GetParam();
   const fesd::Pss model = fesd::make_pss(
       Sliding{}, fesd::PssDims{.n_x = 1, .subsystems = {fesd::Subsystem::from_c(1)}});
   const IntegratorResult r =
       fesd::integrate(model, vec1(0.5), 1.0, 10, options(c.scheme, c.n_s, c.solver));
+  expect_available(r);
+  ASSERT_EQ(r.switches.size(), 1u);
+  EXPECT_NEAR(r.switches[0].t, 0.5, 1e-12);
+  EXPECT_NEAR(r.sensitivities.x0(0, 0), 0.0, 1e-12);
+}
+
+// A sliding exit exactly on a step boundary is outside what is done (its jump needs the exit
+// condition's gradient): not available, with the reason. x1' in -sign(x1) + x2, x2' = 1 from
+// (0.3, -0.5) (tests/integrator/stepper_models.hpp): the exit at t = 1.5, step boundary 15 of 25
+// (where a path places the exit inside a step instead, the value must be the exact
+// [[0, 1], [0, 1]]: the slide forgets x1(0), and x1(T) = (T - t_e)^2 / 2 with t_e = 1 - x2(0)).
+TEST_P(IftSliding, SlidingExitOnAStepBoundaryIsNotAvailable) {
+  const Case c = GetParam();
+  const IntegratorResult r =
+      fesd::integrate(fesd_test::sliding_exit_model(), fesd_test::sliding_exit_x0(), 2.5, 25,
+                      options(c.scheme, c.n_s, c.solver));
   ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
-  EXPECT_FALSE(r.sensitivities.available);
-  EXPECT_NE(r.sensitivities.message.find("lies on a step boundary"), std::string::npos)
-      << r.sensitivities.message;
+  if (r.sensitivities.available) {
+    Eigen::Matrix2d exact;
+    exact << 0, 1, 0, 1;
+    EXPECT_LT((r.sensitivities.x0 - exact).lpNorm<Eigen::Infinity>(), 1e-6) << r.sensitivities.x0;
+  } else {
+    EXPECT_NE(r.sensitivities.message.find("lies on a step boundary"), std::string::npos)
+        << r.sensitivities.message;
+  }
 }
 
 // A crossing exactly on a step boundary: the jump (24) is applied between the two steps
