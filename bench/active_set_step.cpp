@@ -34,6 +34,7 @@
 
 #include <fesd/integrator.hpp>
 #include <fesd/options.hpp>
+#include <fesd/stepper.hpp>
 
 #include "bench_args.hpp"
 #include "bench_timing.hpp"
@@ -159,6 +160,58 @@ Row measure(const Case& c, int N_sim, fesd::StepSolver solver, int repeats) {
   return row;
 }
 
+/// The stepping API on one case (include/fesd/stepper.hpp): a Stepper created once, then
+/// `repeats` passes of N_sim step() calls from x0 (reset() between them; the first pass meets the
+/// shapes and is not timed). Per step: the median and the largest CPU time over all timed steps.
+struct StepperRow {
+  double create_s = 0, first_pass_s = 0;
+  double median_step_s = 0, p99_step_s = 0, max_step_s = 0, mean_step_s = 0;
+  int N_sim = 0, repeats = 0, active_set_steps = 0, homotopy_steps = 0;
+  double error_x = 0;
+};
+
+StepperRow measure_stepper(const Case& c, int N_sim, int repeats) {
+  fesd::IntegratorOptions o;
+  o.discretization.rk_scheme = fesd::RkScheme::RadauIIA;
+  o.discretization.n_s = c.n_s;
+  o.discretization.N_FE = 2;
+  const Eigen::VectorXd none;  // u, p: zero controls, the model's p_default
+  StepperRow row;
+  row.N_sim = N_sim;
+  row.repeats = repeats;
+  double c0 = cpu_now();
+  fesd::Stepper stepper(c.model, c.T / N_sim, o);
+  row.create_s = cpu_now() - c0;
+  Eigen::VectorXd x = c.x0;
+  c0 = cpu_now();
+  for (int k = 0; k < N_sim; ++k) stepper.step(x, none, none, x);
+  row.first_pass_s = cpu_now() - c0;
+  std::vector<double> per_step;
+  per_step.reserve(static_cast<std::size_t>(N_sim) * static_cast<std::size_t>(repeats));
+  for (int r = 0; r < repeats; ++r) {
+    stepper.reset();
+    x = c.x0;
+    for (int k = 0; k < N_sim; ++k) {
+      const auto t0 = std::chrono::steady_clock::now();
+      stepper.step(x, none, none, x);
+      per_step.push_back(
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    }
+  }
+  row.error_x = stepper.status() == fesd::Status::Success ? (x - c.x_exact).norm() : NAN;
+  row.active_set_steps = static_cast<int>(stepper.stats().active_set_steps);
+  row.homotopy_steps = static_cast<int>(stepper.stats().homotopy_steps);
+  double sum = 0;
+  for (double t : per_step) sum += t;
+  row.mean_step_s = sum / static_cast<double>(per_step.size());
+  row.max_step_s = *std::max_element(per_step.begin(), per_step.end());
+  row.median_step_s = median(per_step);
+  std::sort(per_step.begin(), per_step.end());
+  row.p99_step_s =
+      per_step[static_cast<std::size_t>(0.99 * static_cast<double>(per_step.size() - 1))];
+  return row;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -256,6 +309,30 @@ int main(int argc, char** argv) {
         r.nlps_per_step, fmt::format("{}/{}", r.active_set_steps, r.homotopy_steps), r.error_x,
         r.error_t_s, base.cpu_s / r.cpu_s);
   }
+  // The stepping API on the oscillator: time per step() (wall, steady_clock around each call).
+  const StepperRow st = measure_stepper(cases[0], N_sim, repeat_active);
+  fmt::print(
+      "\nfesd::Stepper on the oscillator (47), N_sim = {} steps of h = T / N_sim, {} timed passes "
+      "(the first pass, which meets the shapes, not timed)\n",
+      N_sim, repeat_active);
+  fmt::print("{:>12} {:>14} {:>12} {:>12} {:>12} {:>12} {:>9} {:>9}\n", "create ms",
+             "first pass ms", "median us", "mean us", "p99 us", "max us", "as/hom", "err x(T)");
+  fmt::print("{:>12.3f} {:>14.3f} {:>12.2f} {:>12.2f} {:>12.2f} {:>12.2f} {:>9} {:>9.1e}\n",
+             1e3 * st.create_s, 1e3 * st.first_pass_s, 1e6 * st.median_step_s, 1e6 * st.mean_step_s,
+             1e6 * st.p99_step_s, 1e6 * st.max_step_s,
+             fmt::format("{}/{}", st.active_set_steps, st.homotopy_steps), st.error_x);
+  const nlohmann::json stepper_json{{"problem", cases[0].name},
+                                    {"N_sim", st.N_sim},
+                                    {"repeats", st.repeats},
+                                    {"create_s", st.create_s},
+                                    {"first_pass_s", st.first_pass_s},
+                                    {"median_step_s", st.median_step_s},
+                                    {"mean_step_s", st.mean_step_s},
+                                    {"p99_step_s", st.p99_step_s},
+                                    {"max_step_s", st.max_step_s},
+                                    {"active_set_steps", st.active_set_steps},
+                                    {"homotopy_steps", st.homotopy_steps},
+                                    {"error_x", st.error_x}};
   nlohmann::json cvode_json = nlohmann::json::array();
 #ifdef FESD_BENCH_CVODE
   {
@@ -336,7 +413,9 @@ int main(int argc, char** argv) {
                    {"error_t_s", r.error_t_s},
                    {"path_s", r.path_s},
                    {"setup_s", r.setup_s}});
-    std::ofstream(json_path) << nlohmann::json{{"rows", j}, {"cvode", cvode_json}}.dump(2) << "\n";
+    std::ofstream(json_path)
+        << nlohmann::json{{"rows", j}, {"cvode", cvode_json}, {"stepper", stepper_json}}.dump(2)
+        << "\n";
   }
   return 0;
 }

@@ -14,13 +14,13 @@
 
 namespace fesd::dcs {
 
-/// g(x) for all subsystems, concatenated (length n_theta).
+/// g(x) for all subsystems, concatenated (length n_theta); c, gd: work space (no allocation once
+/// sized).
 template <class T>
-void eval_g(const Pss& m, const T* x, const T* p, T* g) {
-  std::vector<T> c(static_cast<std::size_t>(std::max(m.n_c(), m.n_g())));
+void eval_g(const Pss& m, const T* x, const T* p, T* g, std::vector<T>& c, std::vector<T>& gd) {
+  c.resize(static_cast<std::size_t>(std::max(m.n_c(), m.n_g())));
   if (m.n_c() > 0) m.functions().c(x, p, c.data());
   int c_off = 0, g_off = 0;
-  std::vector<T> gd;
   if (m.n_g() > 0) {
     gd.resize(m.n_g());
     m.functions().g(x, p, gd.data());
@@ -42,17 +42,32 @@ void eval_g(const Pss& m, const T* x, const T* p, T* g) {
     }
   }
 }
+/// The same with a work space per thread and scalar type (no allocation once sized: the blocks
+/// of the active-set path's Newton iterations call it).
+template <class T>
+void eval_g(const Pss& m, const T* x, const T* p, T* g) {
+  thread_local std::vector<T> c, gd;
+  eval_g(m, x, p, g, c, gd);
+}
 
 /// xdot = sum_r f_r(x, u, p) theta_r over all regions r of all subsystems (8a)/(21a).
+/// fr: work space (no allocation once sized).
 template <class T>
-void eval_F_theta(const Pss& m, const T* x, const T* u, const T* p, const T* theta, T* xdot) {
+void eval_F_theta(const Pss& m, const T* x, const T* u, const T* p, const T* theta, T* xdot,
+                  std::vector<T>& fr) {
   const int n_x = m.n_x();
-  std::vector<T> fr(n_x);
+  fr.resize(static_cast<std::size_t>(n_x));
   for (int i = 0; i < n_x; ++i) xdot[i] = T(0.0);
   for (int r = 0; r < m.n_theta(); ++r) {
     m.functions().f(r, x, u, p, fr.data());
     for (int i = 0; i < n_x; ++i) xdot[i] = xdot[i] + fr[i] * theta[r];
   }
+}
+/// The same with a work space per thread and scalar type (as eval_g).
+template <class T>
+void eval_F_theta(const Pss& m, const T* x, const T* u, const T* p, const T* theta, T* xdot) {
+  thread_local std::vector<T> fr;
+  eval_F_theta(m, x, u, p, theta, xdot, fr);
 }
 
 /// The subsystem each region belongs to.
@@ -70,5 +85,8 @@ struct LpSolution {
 };
 LpSolution solve_lp(const Pss& m, const Eigen::VectorXd& x, const Eigen::VectorXd& p,
                     double tie_tol = 1e-12);
+/// The same into `s` with the work space c, gd of eval_g (no allocation once sized: the Stepper).
+void solve_lp(const Pss& m, const double* x, const double* p, LpSolution& s, std::vector<double>& c,
+              std::vector<double>& gd, double tie_tol = 1e-12);
 
 }  // namespace fesd::dcs

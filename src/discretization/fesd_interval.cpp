@@ -471,6 +471,12 @@ bool FesdInterval::stage_active(const double* w, int n, int m, int r) const {
 
 std::vector<int> FesdInterval::active_set(const double* w, int n) const {
   std::vector<int> active;
+  active_set(w, n, active);
+  return active;
+}
+
+void FesdInterval::active_set(const double* w, int n, std::vector<int>& active) const {
+  active.clear();
   for (int r = 0; r < model_.n_theta(); ++r) {
     double th = 0, th_max = 0, la = 0;
     for (int s = 0; s < n_s_; ++s) {
@@ -480,7 +486,6 @@ std::vector<int> FesdInterval::active_set(const double* w, int n) const {
     }
     if (theta_outweighs(th, la, th_max)) active.push_back(r);
   }
-  return active;
 }
 
 std::vector<std::vector<int>> FesdInterval::active_sets(const double* w) const {

@@ -119,6 +119,8 @@ class FesdInterval {
   /// alone (it vanishes for every region at a switching boundary). Integrator and OCP report
   /// switches where this set changes.
   std::vector<int> active_set(const double* w, int n) const;
+  /// The same into `active` (no allocation once its capacity is n_theta).
+  void active_set(const double* w, int n, std::vector<int>& active) const;
   /// Region r at stage m of element n: theta_{n,m,r} > max(|lambda_{n,m,r}|, kActiveThetaTol),
   /// the stage-wise form of active_set().
   bool stage_active(const double* w, int n, int m, int r) const;

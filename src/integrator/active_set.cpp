@@ -77,6 +77,40 @@ ActiveSetStep::ActiveSetStep(const Pss& model, const Tableau& tab, const Discret
   nlp_.finalize();
   g_.resize(nlp_.num_constraints());
   jac_.resize(nlp_.jac_nnz());
+  // the work space of solve() (no allocation in steps once the shapes met have been set up)
+  const int n_th = model.n_theta();
+  w_.reserve(nlp_.x_init.size());
+  w_guess_.reserve(nlp_.x_init.size());
+  w_pred_.reserve(nlp_.x_init.size());
+  w_start_.reserve(nlp_.x_init.size());
+  theta_start_.resize(n_th);
+  for (auto* v :
+       {&predicted_, &active_k_, &off_k_, &sliding_, &pool_, &also_, &bounds_, &sw_in_, &sw_out_})
+    v->reserve(static_cast<std::size_t>(n_th) + 1);
+  for (auto* sets : {&sets_, &predicted_sets_, &active_try_}) {
+    sets->resize(static_cast<std::size_t>(d.N_FE));
+    for (auto& a : *sets) a.reserve(static_cast<std::size_t>(n_th));
+  }
+  t_ok_.reserve(n_th);
+  val_ok_.reserve(n_th);
+  cost_.reserve(static_cast<std::size_t>(d.N_FE));
+}
+
+void ActiveSetStep::set_inputs(const double* u, const double* p) {
+  for (std::size_t i = 0; i < in_.q.size(); ++i)
+    nlp_.x_lb[in_.q[i]] = nlp_.x_ub[in_.q[i]] = nlp_.x_init[in_.q[i]] = u[i];
+  for (std::size_t i = 0; i < in_.p.size(); ++i)
+    nlp_.x_lb[in_.p[i]] = nlp_.x_ub[in_.p[i]] = nlp_.x_init[in_.p[i]] = p[i];
+}
+
+ActiveSetStep::Candidate& ActiveSetStep::add_candidate(Kind kind, int b, int free_at_boundary) {
+  if (n_cand_ == static_cast<int>(cand_.size())) cand_.emplace_back();
+  Candidate& c = cand_[static_cast<std::size_t>(n_cand_++)];
+  c.kind = kind;
+  c.b = b;
+  c.free_at_boundary = free_at_boundary;
+  c.after.clear();
+  return c;
 }
 
 bool ActiveSetStep::solve(const Eigen::VectorXd& x0, const std::vector<int>& prediction,
@@ -99,14 +133,15 @@ bool ActiveSetStep::solve(const Eigen::VectorXd& x0, const std::vector<int>& pre
   if (newton(sets_).converged) {
     predicted_ = prediction;
   } else {
-    const std::vector<std::vector<int>> sel = selections(prediction, lp);
-    for (std::size_t i = 1; i < sel.size(); ++i) {
+    selections(prediction, lp);
+    for (int i = 1; i < n_sel_; ++i) {
+      const std::vector<int>& sel = sel_[static_cast<std::size_t>(i)];
       if (tries_ >= kMaxTries) return false;
       w_ = w_guess_;
       ++tries_;
-      sets_.assign(iv_->N_FE(), sel[i]);
+      sets_.assign(iv_->N_FE(), sel);
       if (newton(sets_).converged) {
-        predicted_ = sel[i];
+        predicted_ = sel;
         break;
       }
     }
@@ -137,30 +172,36 @@ bool ActiveSetStep::solve(const Eigen::VectorXd& x0, const std::vector<int>& pre
   // linear between the last point where the sign held and the first where it failed.
   const double ts = v.t_ok + (v.t_bad - v.t_ok) * v.val_ok / std::max(v.val_ok - v.val_bad, 1e-300);
   const int k = subsystem_of(model_, v.r);
-  // The predicted set with subsystem k's regions replaced by `regions_k` (sorted).
-  const auto with_k = [&](std::vector<int> regions_k) {
+  // Appends the predicted set's regions of the other subsystems to `set` (subsystem k's regions
+  // replaced by those in it), sorted. The sets live in the members (no allocation once sized).
+  const auto with_k = [&](std::vector<int>& set) {
     for (int r : predicted)
-      if (subsystem_of(model_, r) != k) regions_k.push_back(r);
-    std::sort(regions_k.begin(), regions_k.end());
-    return regions_k;
+      if (subsystem_of(model_, r) != k) set.push_back(r);
+    std::sort(set.begin(), set.end());
   };
-  std::vector<int> active_k, off_k;
+  active_k_.clear();
+  off_k_.clear();
   for (int r = model_.region_offset(k); r < model_.region_offset(k + 1); ++r)
-    (discretization::has(predicted, r) ? active_k : off_k).push_back(r);
-  std::vector<Candidate> candidates;
+    (discretization::has(predicted, r) ? active_k_ : off_k_).push_back(r);
+  n_cand_ = 0;
+  boundaries_for(ts);
   if (v.exit) {
     // Leaving a sliding mode: r leaves the set; at the boundary b theta_r = 0 (the pin of
     // FesdInterval::pin_bounds) replaces h_b = h_{b-1}. b = 0: the whole step without r. Then
     // (co-dimension 2: the state leaves both surfaces at once) a region j off the set replacing
     // the subsystem's regions after the pin, lambda_j at the boundary free (not a second switch
     // condition: on the intersection lambda_j = 0 holds whatever the boundary's time).
-    std::vector<int> after = predicted;
-    std::erase(after, v.r);
-    for (int b : boundaries_for(ts)) {
+    for (int b : bounds_) {
       if (b > 0 && !iv_->can_pin_exits()) continue;
-      candidates.push_back({Kind::Exit, after, b});
+      Candidate& c = add_candidate(Kind::Exit, b, -1);
+      c.after = predicted;
+      std::erase(c.after, v.r);
       if (b > 0)
-        for (int j : off_k) candidates.push_back({Kind::Exit, with_k({j}), b, j});
+        for (int j : off_k_) {
+          Candidate& cj = add_candidate(Kind::Exit, b, j);
+          cj.after.push_back(j);
+          with_k(cj.after);
+        }
     }
   } else {
     // A crossing: r replaces the active regions of its subsystem. Entering a sliding mode: r is
@@ -169,48 +210,62 @@ bool ActiveSetStep::solve(const Eigen::VectorXd& x0, const std::vector<int>& pre
     // of the subsystem fail at the same point (the state reaches two surfaces' intersection:
     // periodic_stick_slip.toml), the two-region sets {j, r'} with r' failing and j active or
     // failing: a regular selection of the co-dimension-2 sliding mode (see selections()).
-    std::vector<int> sliding = active_k;
-    sliding.push_back(v.r);
-    std::sort(sliding.begin(), sliding.end());
-    std::vector<std::vector<int>> pairs;
-    std::vector<int> pool = active_k;
-    pool.insert(pool.end(), v.also.begin(), v.also.end());
-    for (int r2 : v.also)
-      for (int j : pool)
-        if (j != r2) {
-          std::vector<int> pair{std::min(j, r2), std::max(j, r2)};
-          if (pair != sliding && std::find(pairs.begin(), pairs.end(), pair) == pairs.end())
-            pairs.push_back(pair);
+    sliding_ = active_k_;
+    sliding_.push_back(v.r);
+    std::sort(sliding_.begin(), sliding_.end());
+    pool_ = active_k_;
+    pool_.insert(pool_.end(), also_.begin(), also_.end());
+    n_pairs_ = 0;
+    for (int r2 : also_)
+      for (int j : pool_) {
+        if (j == r2) continue;
+        const int a = std::min(j, r2), b = std::max(j, r2);
+        const auto is_pair = [&](const std::vector<int>& set) {
+          return set.size() == 2 && set[0] == a && set[1] == b;
+        };
+        if (is_pair(sliding_) || std::any_of(pairs_.begin(), pairs_.begin() + n_pairs_, is_pair))
+          continue;
+        if (n_pairs_ == static_cast<int>(pairs_.size())) pairs_.emplace_back();
+        std::vector<int>& pair = pairs_[static_cast<std::size_t>(n_pairs_++)];
+        pair.clear();
+        pair.push_back(a);
+        pair.push_back(b);
+      }
+    for (int b : bounds_) {
+      add_candidate(Kind::Crossing, b, -1).after.push_back(v.r);
+      with_k(cand_[static_cast<std::size_t>(n_cand_ - 1)].after);
+      add_candidate(Kind::SlidingEntry, b, -1).after = sliding_;
+      with_k(cand_[static_cast<std::size_t>(n_cand_ - 1)].after);
+      if (also_.size() > 1)
+        for (int i = 0; i < n_pairs_; ++i) {
+          add_candidate(Kind::SlidingEntry, b, -1).after = pairs_[static_cast<std::size_t>(i)];
+          with_k(cand_[static_cast<std::size_t>(n_cand_ - 1)].after);
         }
-    for (int b : boundaries_for(ts)) {
-      candidates.push_back({Kind::Crossing, with_k({v.r}), b});
-      candidates.push_back({Kind::SlidingEntry, with_k(sliding), b});
-      if (v.also.size() > 1)
-        for (const auto& pair : pairs) candidates.push_back({Kind::SlidingEntry, with_k(pair), b});
     }
   }
-  const std::vector<double> w_pred = w_;
-  for (const Candidate& c : candidates) {
+  w_pred_ = w_;
+  for (int i = 0; i < n_cand_; ++i) {
+    const Candidate& c = cand_[static_cast<std::size_t>(i)];
     if (tries_ >= kMaxTries) return false;
-    Sets active = predicted_sets;
-    for (int n = c.b; n < iv_->N_FE(); ++n) active[n] = c.after;
-    switched_guess(w_pred, predicted, c.after, c.b, ts);
+    active_try_ = predicted_sets;
+    for (int n = c.b; n < iv_->N_FE(); ++n) active_try_[static_cast<std::size_t>(n)] = c.after;
+    switched_guess(w_pred_, predicted, c.after, c.b, ts);
     ++tries_;
-    std::vector<nlp::Bound> extra;
+    extra_.clear();
     int lam_free = -1;
     if (c.kind == Kind::Exit && c.b > 0) {
-      extra.push_back({iv_->theta(c.b - 1, iv_->n_s() - 1, v.r), 0.0, 0.0});
+      extra_.push_back({iv_->theta(c.b - 1, iv_->n_s() - 1, v.r), 0.0, 0.0});
       if (c.free_at_boundary >= 0) {
         lam_free = iv_->lambda_points(c.b)[0][c.free_at_boundary];
-        extra.push_back({lam_free, nlp_.x_lb[lam_free], nlp_.x_ub[lam_free]});
+        extra_.push_back({lam_free, nlp_.x_lb[lam_free], nlp_.x_ub[lam_free]});
       }
     }
-    if (!newton(active, extra).converged) continue;
-    const Violation again = check_signs(active);
+    if (!newton(active_try_, extra_).converged) continue;
+    const Violation again = check_signs(active_try_);
     if (again.bad || again.r >= 0) continue;
     // an exit into region j: the state is on j's boundary there (lambda_j = 0 to the tolerance)
     if (lam_free >= 0 && std::abs(w_[lam_free]) > kSignTol) continue;
-    if (c.kind == Kind::SlidingEntry && !sliding_is_filippov(active, k, c.b)) continue;
+    if (c.kind == Kind::SlidingEntry && !sliding_is_filippov(active_try_, k, c.b)) continue;
     kind_ = c.kind;
     return true;
   }
@@ -266,8 +321,8 @@ bool ActiveSetStep::solve_fixed(const Eigen::VectorXd& x0, const Sets& active,
 bool ActiveSetStep::sensitivity(StepSensitivity& out, std::string& why) {
   const discretization::FesdInterval& iv = *iv_;
   std::vector<std::pair<int, int>> equal;
-  for (int n : equal_) equal.emplace_back(iv.h(n), iv.h(n - 1));
-  SquareSystem sys(nlp_, free_, std::move(equal));
+  for (int n : cur_->equal) equal.emplace_back(iv.h(n), iv.h(n - 1));
+  SquareSystem sys(nlp_, cur_->free, std::move(equal));
   std::vector<int> inputs = in_.s0, x_end;
   inputs.insert(inputs.end(), in_.q.begin(), in_.q.end());
   inputs.insert(inputs.end(), in_.p.begin(), in_.p.end());
@@ -278,8 +333,7 @@ bool ActiveSetStep::sensitivity(StepSensitivity& out, std::string& why) {
   return true;
 }
 
-std::vector<std::vector<int>> ActiveSetStep::selections(const std::vector<int>& prediction,
-                                                        const dcs::LpSolution& lp) const {
+void ActiveSetStep::selections(const std::vector<int>& prediction, const dcs::LpSolution& lp) {
   // A subsystem with more active regions than one plus its number of independent switching
   // conditions has a family of theta (periodic_stick_slip.toml on x2 = 0.2, x3 = 0.4: f_0 = f_1
   // there, theta_0 + theta_1 is determined, the split is not): the square system is singular, or
@@ -288,26 +342,35 @@ std::vector<std::vector<int>> ActiveSetStep::selections(const std::vector<int>& 
   // one of least theta at the step start, then the two least, ... down to two regions, then each
   // other one alone; the signs then decide as for any set (lambda >= 0 of the left-out regions
   // included), so a selection that changes the state is refused.
-  std::vector<std::vector<int>> out{prediction};
+  // (the sets in sel_, the first n_sel_ of them: no allocation once sized)
+  const auto add = [&]() -> std::vector<int>& {
+    if (n_sel_ == static_cast<int>(sel_.size())) sel_.emplace_back();
+    return sel_[static_cast<std::size_t>(n_sel_++)];
+  };
+  n_sel_ = 0;
+  add() = prediction;
+  std::vector<int>& in_k = pool_;
   for (int k = 0; k < model_.n_sys(); ++k) {
-    std::vector<int> in_k;
+    in_k.clear();
     for (int r : prediction)
       if (subsystem_of(model_, r) == k) in_k.push_back(r);
     if (in_k.size() < 3) continue;
     std::sort(in_k.begin(), in_k.end(), [&](int a, int b) { return lp.theta[a] < lp.theta[b]; });
     // the least theta out, then the two least, ... down to two regions; then each other one out
-    std::vector<int> set = prediction;
     for (std::size_t i = 0; i + 2 < in_k.size(); ++i) {
+      const std::size_t before = static_cast<std::size_t>(n_sel_ - 1);
+      std::vector<int>& set = add();
+      set = i == 0 ? prediction : sel_[before];
       std::erase(set, in_k[i]);
-      out.push_back(set);
     }
     for (std::size_t i = 1; i < in_k.size(); ++i) {
+      std::vector<int>& set = add();
       set = prediction;
       std::erase(set, in_k[i]);
-      if (std::find(out.begin(), out.end(), set) == out.end()) out.push_back(set);
+      if (std::find(sel_.begin(), sel_.begin() + n_sel_ - 1, set) != sel_.begin() + n_sel_ - 1)
+        --n_sel_;
     }
   }
-  return out;
 }
 
 bool ActiveSetStep::sliding_is_filippov(const Sets& active, int k, int b) const {
@@ -327,18 +390,18 @@ bool ActiveSetStep::sliding_is_filippov(const Sets& active, int k, int b) const 
 }
 
 ActiveSetTry ActiveSetStep::newton(const Sets& active, const std::vector<nlp::Bound>& extra) {
-  if (!shape_valid_ || !same_shape(active, extra)) restrict_to(active, extra);
-  // the start state (the only bounds that change between steps of one shape)
-  for (int j : in_.s0) lb_[j] = ub_[j] = nlp_.x_lb[j];
-  for (int j : fixed_) w_[j] = lb_[j];
-  const int n_eq = nlp_.num_constraints() + static_cast<int>(equal_.size());
-  if (n_eq != static_cast<int>(free_.size())) return {};  // not square: not handled here
+  use_shape(active, extra);
+  Shape& sh = *cur_;
+  // the inputs s0, q, p (the only bounds that change between steps of one shape)
+  for (const std::vector<int>* vars : {&in_.s0, &in_.q, &in_.p})
+    for (int j : *vars) sh.lb[j] = sh.ub[j] = nlp_.x_lb[j];
+  for (int j : sh.fixed) w_[j] = sh.lb[j];
+  if (!sh.square) return {};  // not square: not handled here
   chord_converged_ = false;
   if (!lu_current_) return iterate(false);
   // The LU of a step before with this shape: simplified Newton from it first; where that does
   // not converge, Newton with fresh Jacobians from the same start.
-  w_start_.resize(w_.size());  // sized once
-  std::copy(w_.begin(), w_.end(), w_start_.begin());
+  w_start_ = w_;  // sized once
   ActiveSetTry out = iterate(true);
   // Converged: the Jacobian at the solution must be regular (Thm 15's local uniqueness; a stale
   // LU can converge where it is singular), and its LU is the one held for the next step.
@@ -356,20 +419,25 @@ bool ActiveSetStep::factor() {
   if (!nlp_.eval_jac_g(w_.data(), jac_.data())) return false;
   // the restricted Jacobian: the entries of free columns (zeroed first: an entry may be the sum
   // of several); the equal-length rows are constant (restrict_to)
+  const Shape& sh = *cur_;
   double* J = J_.data();
-  for (const auto& [e, pos] : jac_map_) J[pos] = 0;
-  for (const auto& [e, pos] : jac_map_) J[pos] += jac_[e];
+  for (const auto& [e, pos] : sh.jac_map) J[pos] = 0;
+  for (const auto& [e, pos] : sh.jac_map) J[pos] += jac_[e];
+  for (const auto& [pos, value] : sh.constant) J[pos] = value;
   ++factorizations_;
   // A singular Jacobian (not square in effect): the smallest pivot of the LU against the largest
   // (SparseLu::factor).
-  lu_current_ = lu_.factor(J);
+  lu_current_ = cur_->lu.factor(J);
   return lu_current_;
 }
 
 ActiveSetTry ActiveSetStep::iterate(bool reuse) {
   const discretization::FesdInterval& iv = *iv_;
   const int m = nlp_.num_constraints();
-  const int n_free = static_cast<int>(free_.size());
+  const std::vector<int>& free = cur_->free;
+  const std::vector<int>& equal = cur_->equal;
+  const int n_free = static_cast<int>(free.size());
+  const Eigen::Map<Eigen::VectorXd> F(F_.data(), n_free), dz(dz_.data(), n_free);
   ActiveSetTry out;
   // Newton's method: a Jacobian of every iterate. With `reuse`, simplified Newton with the LU
   // held until it stops contracting (or kMaxStale iterations), then Newton's method.
@@ -379,56 +447,89 @@ ActiveSetTry ActiveSetStep::iterate(bool reuse) {
   for (int it = 0; it < kMaxNewton; ++it) {
     if (!nlp_.eval_g(w_.data(), g_.data())) return out;
     for (int i = 0; i < m; ++i) F_[i] = g_[i] - nlp_.g_lb[i];
-    for (std::size_t e = 0; e < equal_.size(); ++e)
-      F_[m + static_cast<int>(e)] = w_[iv.h(equal_[e])] - w_[iv.h(equal_[e] - 1)];
+    for (std::size_t e = 0; e < equal.size(); ++e)
+      F_[m + e] = w_[iv.h(equal[e])] - w_[iv.h(equal[e] - 1)];
     double w_max = 1;
-    for (int j : free_) w_max = std::max(w_max, std::abs(w_[j]));
-    if (F_.lpNorm<Eigen::Infinity>() <= 1e-13 * w_max) {
+    for (int j : free) w_max = std::max(w_max, std::abs(w_[j]));
+    if (F.lpNorm<Eigen::Infinity>() <= 1e-13 * w_max) {
       out.converged = true;
       return out;
     }
     if (full && !factor()) return out;
-    dz_ = -F_;
-    lu_.solve(dz_.data());
+    for (int i = 0; i < n_free; ++i) dz_[i] = -F_[i];
+    cur_->lu.solve(dz_.data());
     ++out.iterations;
     ++iterations_;
-    if (!dz_.allFinite()) return out;
-    for (int i = 0; i < n_free; ++i) w_[free_[i]] += dz_[i];
-    const double dz = dz_.lpNorm<Eigen::Infinity>();
+    if (!dz.allFinite()) return out;
+    for (int i = 0; i < n_free; ++i) w_[free[i]] += dz_[i];
+    const double dz_norm = dz.lpNorm<Eigen::Infinity>();
     // A step below round-off counts as converged with a Jacobian of this iterate only (with an
     // older one the remaining error is not bounded by the step).
-    if (full && dz <= 1e-14 * w_max) {
+    if (full && dz_norm <= 1e-14 * w_max) {
       out.converged = true;
       return out;
     }
     // The simplified iteration contracts too slowly: Newton's method from the next iterate.
-    if (!full) full = ++stale >= kMaxStale || (dz_before > 0 && dz > kChordContraction * dz_before);
-    dz_before = dz;
+    if (!full)
+      full = ++stale >= kMaxStale || (dz_before > 0 && dz_norm > kChordContraction * dz_before);
+    dz_before = dz_norm;
   }
   return out;
 }
 
-bool ActiveSetStep::same_shape(const Sets& active, const std::vector<nlp::Bound>& extra) const {
-  if (active != shape_ || extra.size() != shape_extra_.size()) return false;
+bool ActiveSetStep::same_shape(const Shape& sh, const Sets& active,
+                               const std::vector<nlp::Bound>& extra) {
+  if (active != sh.active || extra.size() != sh.extra.size()) return false;
   for (std::size_t i = 0; i < extra.size(); ++i)
-    if (extra[i].var != shape_extra_[i].var || extra[i].lb != shape_extra_[i].lb ||
-        extra[i].ub != shape_extra_[i].ub)
+    if (extra[i].var != sh.extra[i].var || extra[i].lb != sh.extra[i].lb ||
+        extra[i].ub != sh.extra[i].ub)
       return false;
   return true;
 }
 
-void ActiveSetStep::restrict_to(const Sets& active, const std::vector<nlp::Bound>& extra) {
+void ActiveSetStep::use_shape(const Sets& active, const std::vector<nlp::Bound>& extra) {
+  ++use_clock_;
+  if (cur_ != nullptr && same_shape(*cur_, active, extra)) {
+    cur_->last_use = use_clock_;
+    return;
+  }
+  // Another shape: the LU held was of the one before (a kept shape's LU is of an older step, not
+  // used for simplified Newton; its KLU workspaces and pivot order are reused by factor()).
+  lu_current_ = false;
+  Shape* sh = nullptr;
+  for (const auto& kept : shapes_)
+    if (same_shape(*kept, active, extra)) {
+      sh = kept.get();
+      break;
+    }
+  if (sh == nullptr) {
+    if (static_cast<int>(shapes_.size()) < kMaxShapes) {
+      shapes_.push_back(std::make_unique<Shape>());
+      sh = shapes_.back().get();
+    } else {
+      sh = std::min_element(shapes_.begin(), shapes_.end(), [](const auto& a, const auto& b) {
+             return a->last_use < b->last_use;
+           })->get();
+    }
+    restrict_to(*sh, active, extra);
+  }
+  cur_ = sh;
+  cur_->last_use = use_clock_;
+}
+
+void ActiveSetStep::restrict_to(Shape& sh, const Sets& active,
+                                const std::vector<nlp::Bound>& extra) {
   const discretization::FesdInterval& iv = *iv_;
   const int N = iv.N_FE();
-  shape_ = active;
-  shape_extra_ = extra;
-  shape_valid_ = true;
-  lu_current_ = false;  // the LU held was of another shape
-  lb_ = nlp_.x_lb;
-  ub_ = nlp_.x_ub;
+  sh.active = active;
+  sh.extra = extra;
+  std::vector<double>& lb = sh.lb;
+  std::vector<double>& ub = sh.ub;
+  lb = nlp_.x_lb;
+  ub = nlp_.x_ub;
   for (const nlp::Bound& bd : iv.active_set_bounds(active)) {
-    lb_[bd.var] = bd.lb;
-    ub_[bd.var] = bd.ub;
+    lb[bd.var] = bd.lb;
+    ub[bd.var] = bd.ub;
   }
   // Schemes that are not stiffly accurate (Gauss-Legendre): the end point x_{n+1} of an element is
   // not a stage, and its boundary LP (33) has its own lambda_end, mu_end. In a sliding element
@@ -458,63 +559,75 @@ void ActiveSetStep::restrict_to(const Sets& active, const std::vector<nlp::Bound
       for (int r : active[n]) {
         if (r < first || r >= end) continue;
         if (first_kept) {
-          lb_[iv.lambda_end(n, r)] = -nlp::kInf;
-          ub_[iv.lambda_end(n, r)] = nlp::kInf;
+          lb[iv.lambda_end(n, r)] = -nlp::kInf;
+          ub[iv.lambda_end(n, r)] = nlp::kInf;
         }
         first_kept = true;
       }
     }
   }
   for (const nlp::Bound& bd : extra) {  // a sliding exit: theta_r = 0 at the boundary
-    lb_[bd.var] = bd.lb;
-    ub_[bd.var] = bd.ub;
+    lb[bd.var] = bd.lb;
+    ub[bd.var] = bd.ub;
   }
-  free_.clear();
-  fixed_.clear();
-  col_of_.assign(lb_.size(), -1);
-  for (std::size_t j = 0; j < lb_.size(); ++j) {
-    if (lb_[j] < ub_[j]) {
-      col_of_[j] = static_cast<int>(free_.size());
-      free_.push_back(static_cast<int>(j));
+  std::vector<int>& free = sh.free;
+  std::vector<int>& fixed = sh.fixed;
+  std::vector<int>& col_of = sh.col_of;
+  std::vector<int>& equal = sh.equal;
+  free.clear();
+  fixed.clear();
+  col_of.assign(lb.size(), -1);
+  for (std::size_t j = 0; j < lb.size(); ++j) {
+    if (lb[j] < ub[j]) {
+      col_of[j] = static_cast<int>(free.size());
+      free.push_back(static_cast<int>(j));
     } else {
-      fixed_.push_back(static_cast<int>(j));
+      fixed.push_back(static_cast<int>(j));
     }
   }
   // h_n = h_{n-1} where the active set does not change; at a switch the boundary's length is
   // free and the switch condition takes its row: lambda = 0 of both regions there (a crossing,
   // a sliding entry; fixed above), or theta_r = 0 of the leaving region (an exit: the pin).
-  equal_.clear();
+  equal.clear();
   for (int n = 1; n < N; ++n)
-    if (active[n] == active[n - 1]) equal_.push_back(n);
+    if (active[n] == active[n - 1]) equal.push_back(n);
   const int m = nlp_.num_constraints();
-  const int n_free = static_cast<int>(free_.size());
-  if (m + static_cast<int>(equal_.size()) != n_free) return;  // not square: newton() says so
-  J_.setZero(n_free, n_free);
-  F_.resize(n_free);
+  const int n_free = static_cast<int>(free.size());
+  sh.square = m + static_cast<int>(equal.size()) == n_free;
+  if (!sh.square) return;  // not square: newton() says so
+  const auto n2 = static_cast<std::size_t>(n_free) * static_cast<std::size_t>(n_free);
+  if (J_.size() < n2) J_.resize(n2);
+  if (F_.size() < static_cast<std::size_t>(n_free)) {
+    F_.resize(static_cast<std::size_t>(n_free));
+    dz_.resize(static_cast<std::size_t>(n_free));
+  }
   const std::vector<int>& rows = nlp_.jac_rows();
   const std::vector<int>& cols = nlp_.jac_cols();
-  jac_map_.clear();
+  std::vector<std::pair<int, int>>& jac_map = sh.jac_map;
+  jac_map.clear();
+  sh.constant.clear();
   for (std::size_t e = 0; e < jac_.size(); ++e)
-    if (const int c = col_of_[cols[e]]; c >= 0)
-      jac_map_.emplace_back(static_cast<int>(e), rows[e] + n_free * c);
+    if (const int c = col_of[cols[e]]; c >= 0)
+      jac_map.emplace_back(static_cast<int>(e), rows[e] + n_free * c);
   std::vector<int> pattern;
-  pattern.reserve(jac_map_.size() + 2 * equal_.size());
-  for (const auto& [e, pos] : jac_map_) pattern.push_back(pos);
-  for (std::size_t e = 0; e < equal_.size(); ++e) {
+  pattern.reserve(jac_map.size() + 2 * equal.size());
+  for (const auto& [e, pos] : jac_map) pattern.push_back(pos);
+  for (std::size_t e = 0; e < equal.size(); ++e) {
     const int row = m + static_cast<int>(e);
-    for (const auto& [col, value] : {std::pair{col_of_[iv.h(equal_[e])], 1.0},
-                                     std::pair{col_of_[iv.h(equal_[e] - 1)], -1.0}}) {
-      J_(row, col) = value;
+    for (const auto& [col, value] :
+         {std::pair{col_of[iv.h(equal[e])], 1.0}, std::pair{col_of[iv.h(equal[e] - 1)], -1.0}}) {
+      sh.constant.emplace_back(row + n_free * col, value);
       pattern.push_back(row + n_free * col);
     }
   }
-  lu_.analyze(n_free, std::move(pattern));
+  sh.lu.analyze(n_free, std::move(pattern));
 }
 
 ActiveSetStep::Violation ActiveSetStep::check_signs(const Sets& active) const {
   const discretization::FesdInterval& iv = *iv_;
   const int N = iv.N_FE(), n_s = iv.n_s(), n_th = model_.n_theta();
   Violation v;
+  also_.clear();
   const double h_tol = 1e-12 * T_;
   for (int n = 0; n < N; ++n) {
     const double hn = w_[iv.h(n)];
@@ -567,7 +680,7 @@ ActiveSetStep::Violation ActiveSetStep::check_signs(const Sets& active) const {
           const int k = subsystem_of(model_, r);
           for (int j = r; j < model_.region_offset(k + 1); ++j)
             if (!discretization::has(active[n], j) && w_[points[q][j]] < -kSignTol)
-              v.also.push_back(j);
+              also_.push_back(j);
           return v;
         }
         t_ok[r] = t;
@@ -579,25 +692,29 @@ ActiveSetStep::Violation ActiveSetStep::check_signs(const Sets& active) const {
   return v;
 }
 
-std::vector<int> ActiveSetStep::boundaries_for(double ts) const {
+void ActiveSetStep::boundaries_for(double ts) {
   const int N = iv_->N_FE();
+  std::vector<int>& out = bounds_;
+  out.clear();
   // The switch at the step's start (within 1e-9 T: an exit of a region whose theta reached 0 at
   // the end of the step before), not after an element of length ~0.
-  if (ts <= 1e-9 * T_) return {0};
+  if (ts <= 1e-9 * T_) {
+    out.push_back(0);
+    return;
+  }
   const double h0 = T_ / N, lo = nlp_.x_lb[iv_->h(0)], hi = nlp_.x_ub[iv_->h(0)];
   const auto within = [&](double h) { return h >= lo && h <= hi; };
-  std::vector<std::pair<double, int>> cost;
+  std::vector<std::pair<double, int>>& cost = cost_;
+  cost.clear();
   for (int b = 1; b < N; ++b) {
     const double before = ts / b, after = (T_ - ts) / (N - b);
     if (!within(before) || !within(after)) continue;
     cost.push_back({b * (before - h0) * (before - h0) + (N - b) * (after - h0) * (after - h0), b});
   }
   std::sort(cost.begin(), cost.end());
-  std::vector<int> out;
   for (const auto& [c, b] : cost) out.push_back(b);
   // A switch at (or just after) the step start: the whole step in the new active set.
   if (ts < h0) out.push_back(0);
-  return out;
 }
 
 void ActiveSetStep::switched_guess(const std::vector<double>& w_pred,
@@ -607,7 +724,10 @@ void ActiveSetStep::switched_guess(const std::vector<double>& w_pred,
   const int N = iv.N_FE(), n_s = iv.n_s();
   w_ = w_pred;
   for (int n = 0; n < N; ++n) w_[iv.h(n)] = b == 0 ? T_ / N : n < b ? ts / b : (T_ - ts) / (N - b);
-  std::vector<int> in, out;
+  std::vector<int>& in = sw_in_;
+  std::vector<int>& out = sw_out_;
+  in.clear();
+  out.clear();
   for (int r : after)
     if (!discretization::has(before, r)) in.push_back(r);
   for (int r : before)

@@ -21,6 +21,7 @@
 // is reduced to a regular selection (selections()). If no consistent active set is found within
 // kMaxTries square systems, solve() returns false and the integrator uses the homotopy.
 #pragma once
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -63,6 +64,12 @@ class ActiveSetStep {
   bool solve(const Eigen::VectorXd& x0, const std::vector<int>& prediction,
              const dcs::LpSolution& lp, const Eigen::VectorXd& xdot);
 
+  /// The controls u and parameters p of the following solves (sizes n_u, n_p; no allocation).
+  void set_inputs(const double* u, const double* p);
+
+  /// The next solve() starts with fresh Jacobians (no LU held from a step before).
+  void forget_lu() { lu_current_ = false; }
+
   const discretization::FesdInterval& interval() const { return *iv_; }
   const std::vector<double>& solution() const { return w_; }
   /// Of the last solve(): Newton iterations and square systems tried (all tries).
@@ -71,7 +78,7 @@ class ActiveSetStep {
   int factorizations() const { return factorizations_; }
   int tries() const { return tries_; }
   /// Size of the square system (per active-set shape; the last one solved).
-  int system_size() const { return static_cast<int>(free_.size()); }
+  int system_size() const { return cur_ == nullptr ? 0 : static_cast<int>(cur_->free.size()); }
 
   /// The square system with the active sets `active` (one per element; an exit of a sliding mode
   /// between elements n-1 and n pinned by theta_r = 0 at the end of element n-1, as in solve())
@@ -126,12 +133,11 @@ class ActiveSetStep {
   struct Violation {
     int r = -1;
     bool exit = false;
-    /// An entry: every region of r's subsystem off the set whose lambda fails at that point (r
-    /// first).
-    std::vector<int> also;
     double t_ok = 0, t_bad = 0, val_ok = 0, val_bad = 0;
     bool bad = false;
   };
+  /// Also fills also_ for an entry: every region of r's subsystem off the set whose lambda fails
+  /// at that point (r first).
   Violation check_signs(const Sets& active) const;
   /// The candidates tried after a failed prediction: elements from b on have the set `after`.
   struct Candidate {
@@ -146,14 +152,15 @@ class ActiveSetStep {
   /// sliding, whose theta may be a one-parameter family) the prediction without its region of
   /// least theta in `lp` (the step start), without the two least, ... down to two regions, then
   /// without each other one.
-  std::vector<std::vector<int>> selections(const std::vector<int>& prediction,
-                                           const dcs::LpSolution& lp) const;
+  /// Written into sel_ (its first n_sel_ entries).
+  void selections(const std::vector<int>& prediction, const dcs::LpSolution& lp);
   /// A sliding entry into subsystem k at boundary b is a Filippov sliding mode: theta^k strictly
   /// inside its simplex at every stage from element b on (kSlidingThetaTol).
   bool sliding_is_filippov(const Sets& active, int k, int b) const;
   /// Boundaries b (0..N_FE-1) where a switch at time ts can sit with every h_n within its bounds,
-  /// best first (the least sum (h_n - T/N_FE)^2, the homotopy's heuristic_mean choice).
-  std::vector<int> boundaries_for(double ts) const;
+  /// best first (the least sum (h_n - T/N_FE)^2, the homotopy's heuristic_mean choice); written
+  /// into bounds_.
+  void boundaries_for(double ts);
   /// Guess of the switched system: elements from b on with `after` instead of `before`, element
   /// lengths ts / b and (T - ts) / (N_FE - b), from the converged prediction w_pred.
   void switched_guess(const std::vector<double>& w_pred, const std::vector<int>& before,
@@ -167,33 +174,61 @@ class ActiveSetStep {
   discretization::IntervalInputs in_;
   std::unique_ptr<discretization::FesdInterval> iv_;
   std::vector<double> w_;
-  /// Sets up the square system of a shape (active sets and extra bounds): the bounds with the
-  /// active set applied, the free variables (column map), the fixed ones, the equal-length rows,
-  /// where each Jacobian entry goes in the dense matrix. Done once per shape: newton() with the
-  /// shape of the call before (most steps: the prediction, as the step before) only refreshes s0.
-  void restrict_to(const Sets& active, const std::vector<nlp::Bound>& extra);
-  bool same_shape(const Sets& active, const std::vector<nlp::Bound>& extra) const;
+  /// The square system of one shape (active sets and extra bounds): the bounds with the active
+  /// set applied, the free variables (column map), the fixed ones, the equal-length rows, where
+  /// each Jacobian entry goes in the dense storage J_, and its sparse LU (pattern analysed once).
+  /// Shapes are kept (up to kMaxShapes, the least recently used replaced): a shape met before is
+  /// set up again without allocation, its KLU workspaces reused (docs/active-set.md, "Stepping
+  /// API").
+  struct Shape {
+    Sets active;
+    std::vector<nlp::Bound> extra;
+    std::vector<double> lb, ub;
+    std::vector<int> free, col_of, fixed, equal;
+    std::vector<std::pair<int, int>> jac_map;      // (Jacobian entry, index into J_)
+    std::vector<std::pair<int, double>> constant;  // the equal-length rows: (index, value)
+    SparseLu lu;
+    bool square = false;
+    long last_use = 0;
+  };
+  static constexpr int kMaxShapes = 64;
+  /// Makes the shape of (active, extra) current: found among those kept, else set up (restrict_to).
+  /// newton() with the shape of the call before (most steps: the prediction, as the step before)
+  /// only refreshes the inputs s0, q, p.
+  void use_shape(const Sets& active, const std::vector<nlp::Bound>& extra);
+  void restrict_to(Shape& sh, const Sets& active, const std::vector<nlp::Bound>& extra);
+  static bool same_shape(const Shape& sh, const Sets& active, const std::vector<nlp::Bound>& extra);
 
-  // per square system (shape): the free variables (column map), bounds with the active set applied
-  Sets shape_;
-  std::vector<nlp::Bound> shape_extra_;
-  bool shape_valid_ = false;
-  std::vector<int> free_, col_of_, fixed_, equal_;
-  std::vector<std::pair<int, int>> jac_map_;  // (Jacobian entry, index into J_'s storage)
-  std::vector<double> lb_, ub_;
-  Eigen::MatrixXd J_;
-  SparseLu lu_;              // KLU on J_'s nonzeros, the pattern analysed per shape (restrict_to)
-  bool lu_current_ = false;  // lu_ factors a Jacobian of the current shape
+  std::vector<std::unique_ptr<Shape>> shapes_;
+  Shape* cur_ = nullptr;
+  long use_clock_ = 0;
+  std::vector<double> J_;  // dense column-major storage of the current shape's Jacobian
+  // cur_->lu factors a Jacobian of the current shape (of this step or one before)
+  bool lu_current_ = false;
   bool chord_converged_ = false;  // the last newton() converged with the LU of a step before
   std::vector<double> w_start_;   // newton()'s start, for the restart with fresh Jacobians
-  Eigen::VectorXd F_, dz_;
+  std::vector<double> F_, dz_;
   std::vector<double> g_, jac_;
   Eigen::VectorXd theta_start_;  // theta at the step start (the guess's LP): exit times
   // work space of solve() and check_signs(), kept between steps (no allocation once sized)
-  std::vector<double> w_guess_;
+  std::vector<double> w_guess_, w_pred_;
   std::vector<int> predicted_;
-  Sets sets_, predicted_sets_;
+  Sets sets_, predicted_sets_, active_try_;
   mutable std::vector<double> t_ok_, val_ok_;
+  mutable std::vector<int> also_;
+  std::vector<std::vector<int>> sel_;  // selections(): n_sel_ sets
+  int n_sel_ = 0;
+  std::vector<int> bounds_;                   // boundaries_for()
+  std::vector<std::pair<double, int>> cost_;  // boundaries_for()
+  std::vector<int> active_k_, off_k_, sliding_, pool_;
+  std::vector<std::vector<int>> pairs_;
+  int n_pairs_ = 0;
+  std::vector<Candidate> cand_;  // the candidates of solve(): n_cand_ of them
+  int n_cand_ = 0;
+  std::vector<nlp::Bound> extra_;
+  std::vector<int> sw_in_, sw_out_;  // switched_guess()
+  /// The next of the n_cand_ candidates (cand_ grows only past its largest count so far).
+  Candidate& add_candidate(Kind kind, int b, int free_at_boundary);
   int iterations_ = 0, tries_ = 0, factorizations_ = 0;
   Kind kind_ = Kind::Prediction;
 };

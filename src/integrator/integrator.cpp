@@ -226,10 +226,12 @@ class Integrator {
       if (res_.sensitivities.available) {
         integrator::StepSensitivity s;
         std::string why;
-        if (as.sensitivity(s, why))
+        if (as.sensitivity(s, why)) {
+          jump_at_step_start(as.interval(), as.solution());
           chain(s);
-        else
+        } else {
           sensitivity_unavailable(why);
+        }
       }
       last_.comp_residual =
           mpcc::comp_residual(as.solution().data(), as.interval().residual_pairs());
@@ -237,13 +239,15 @@ class Integrator {
       return true;
     }
     for (const Piece& piece : pieces_) {
-      if (res_.sensitivities.available) {
-        if (piece.sens_why.empty())
-          chain(piece.sens);
-        else
-          sensitivity_unavailable(piece.sens_why);
-      }
       const discretization::FesdInterval& iv = active_level(piece.level).interval();
+      if (res_.sensitivities.available) {
+        if (piece.sens_why.empty()) {
+          jump_at_step_start(iv, piece.w);
+          chain(piece.sens);
+        } else {
+          sensitivity_unavailable(piece.sens_why);
+        }
+      }
       const double comp = mpcc::comp_residual(piece.w.data(), iv.residual_pairs());
       last_.comp_residual = std::max(last_.comp_residual, comp);
       commit(iv, piece.w, comp, {});
@@ -390,6 +394,7 @@ class Integrator {
     const std::size_t first_element = res_.active_set.size();
     accept(iv, w);
     if (res_.sensitivities.available) check_single_changes(first_element, t_step);
+    jump_at_start_ = false;
     // An exit at the end of the step before, whose pin failed there, is recorded here (the switch
     // at a step boundary belongs to the step that starts at it).
     if (!carried_unlocated_.empty()) mark_switches(first_switch, carried_unlocated_);
@@ -574,6 +579,72 @@ class Integrator {
     sens.p = s.x0 * sens.p + s.p;
   }
 
+  /// A crossing exactly at the start of the step (solution w of iv) from x_, i.e. on a step
+  /// boundary (a fixed time, which neither step's IFT can move): the jump (24) of the
+  /// sensitivities there, D <- J D with J = I + (f_j - f_i) grad psi' / (grad psi' f_i),
+  /// psi = g_i - g_j, for the region i of the element before and j of the first element (one
+  /// region of one subsystem replaced by one other; the crossing transversal: grad psi' f_i > 0).
+  /// A sliding entry (j joins the one region i of its subsystem; grad psi' f_j < 0) the same with
+  /// f_j replaced by the sliding field f* (Prop. 9's remark). Then check_single_changes() accepts
+  /// the switch there. A sliding exit on a step boundary is not done: not available, as before.
+  void jump_at_step_start(const discretization::FesdInterval& iv, const std::vector<double>& w) {
+    jump_at_start_ = false;
+    if (!res_.sensitivities.available || res_.active_set.empty()) return;
+    const std::vector<int>& before = res_.active_set.back();
+    const std::vector<int> after = iv.active_set(w.data(), 0);
+    if (after == before) return;
+    int i = -1, j = -1;
+    bool sliding = false;  // j joins i: a sliding entry (f* for f_j)
+    for (int k = 0; k < model_.n_sys(); ++k) {
+      const int first = model_.region_offset(k), end = model_.region_offset(k + 1);
+      std::vector<int> b, a;
+      for (int r : before)
+        if (r >= first && r < end) b.push_back(r);
+      for (int r : after)
+        if (r >= first && r < end) a.push_back(r);
+      if (a == b) continue;
+      if (b.size() != 1 || i >= 0) return;  // not a single switch out of one region
+      i = b[0];
+      if (a.size() == 1) {
+        j = a[0];
+      } else if (a.size() == 2 && (a[0] == i || a[1] == i)) {
+        j = a[0] == i ? a[1] : a[0];
+        sliding = true;
+      } else {
+        return;
+      }
+    }
+    constexpr int kMaxJet = 128;
+    const int n_x = model_.n_x();
+    if (i < 0 || n_x > kMaxJet) return;
+    using Jet = ad::Jet<kMaxJet>;
+    std::vector<Jet> xj(static_cast<std::size_t>(n_x)), pj(static_cast<std::size_t>(model_.n_p())),
+        gj(static_cast<std::size_t>(model_.n_theta()));
+    for (int a = 0; a < n_x; ++a) xj[a] = Jet::variable(x_[a], a, n_x);
+    for (int b = 0; b < model_.n_p(); ++b) pj[b] = Jet(p_[b]);
+    dcs::eval_g<Jet>(model_, xj.data(), pj.data(), gj.data());
+    Eigen::VectorXd grad(n_x), f_i(n_x), f_j(n_x);
+    for (int a = 0; a < n_x; ++a) grad[a] = gj[i].d(a) - gj[j].d(a);
+    model_.functions().f(i, x_.data(), u_.data(), p_.data(), f_i.data());
+    model_.functions().f(j, x_.data(), u_.data(), p_.data(), f_j.data());
+    const double normal = grad.dot(f_i);
+    if (!(normal > 1e-12 * grad.norm() * f_i.norm()) || !std::isfinite(normal)) return;
+    if (sliding) {
+      // Prop. 9's remark: f_j replaced by the sliding field f* = f_i + theta_j (f_j - f_i) with
+      // grad psi' f* = 0; an attracting surface: grad psi' f_j < 0, so theta_j in (0, 1).
+      const double normal_j = grad.dot(f_j);
+      if (!(normal_j < -1e-12 * grad.norm() * f_j.norm()) || !std::isfinite(normal_j)) return;
+      f_j = f_i + normal / (normal - normal_j) * (f_j - f_i);
+    }
+    const Eigen::MatrixXd J =
+        Eigen::MatrixXd::Identity(n_x, n_x) + (f_j - f_i) * grad.transpose() / normal;
+    Sensitivities& sens = res_.sensitivities;
+    sens.x0 = J * sens.x0;
+    sens.u = J * sens.u;
+    sens.p = J * sens.p;
+    jump_at_start_ = true;
+  }
+
   /// The first step (from t_) whose sensitivity is not available ends the chain.
   void sensitivity_unavailable(const std::string& why) {
     Sensitivities& sens = res_.sensitivities;
@@ -600,7 +671,7 @@ class Integrator {
             "at t = {:.6g} the active set changes from {} to {} regions (Thm 19 assumes at most "
             "one change per switch)",
             res_.t[n], a[n - 1].size(), a[n].size());
-      else if (n == first && d_.use_fesd && a[n] != a[n - 1])
+      else if (n == first && d_.use_fesd && a[n] != a[n - 1] && !jump_at_start_)
         why = fmt::format(
             "the switch at t = {:.6g} lies on a step boundary, a fixed time (not a free element "
             "boundary), where the derivative of the switch time is lost; another N_sim moves it "
@@ -656,10 +727,12 @@ class Integrator {
         a = std::make_unique<integrator::StandardStepSensitivity>(model_, tab_, dr, T, u_, p_);
       ok = a->compute(x_, *sp.iv, w, s, why);
     }
-    if (ok)
+    if (ok) {
+      if (d_.use_fesd) jump_at_step_start(*sp.iv, w);
       chain(s);
-    else
+    } else {
       sensitivity_unavailable(why.empty() ? "the square system failed" : why);
+    }
   }
 
   // ---- pieces ----
@@ -887,6 +960,7 @@ class Integrator {
   const StepProblem* failed_ = nullptr;  // the last failed attempt
   bool settings_cannot_reach_ = false;   // the homotopy's last sigma > complementarity_tol
   std::vector<int> carried_unlocated_;   // unpinned exits of the step before
+  bool jump_at_start_ = false;           // jump_at_step_start() applied (24) at this step's start
 };
 
 }  // namespace

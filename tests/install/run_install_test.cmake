@@ -22,6 +22,13 @@ if(rc)
   message(FATAL_ERROR "the consumer program failed (${rc})")
 endif()
 
+# The stepping API in a control loop (examples/cpp/stepper_loop.cpp, docs/active-set.md).
+execute_process(COMMAND ${WORK_DIR}/build/stepper_loop RESULT_VARIABLE rc OUTPUT_VARIABLE out)
+message(STATUS "${out}")
+if(rc)
+  message(FATAL_ERROR "the stepper_loop program failed (${rc})")
+endif()
+
 # The Python package (docs/python.md): installed under PYTHON_DIR (relative to the prefix), it
 # imports from there with the build tree out of reach and loads the installed libfesd (RUNPATH).
 if(PYTHON AND PYTHON_DIR AND NOT IS_ABSOLUTE "${PYTHON_DIR}")

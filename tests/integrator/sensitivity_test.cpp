@@ -15,6 +15,7 @@
 #include "fesd/integrator.hpp"
 #include "fesd/model.hpp"
 #include "fesd/problem_file.hpp"
+#include "integrator/stepper_models.hpp"
 
 namespace {
 
@@ -129,24 +130,55 @@ TEST_P(IftSliding, IsZeroAfterSliding) {
   }
 }
 
-// A switch exactly on a step boundary (a fixed time, not a free element boundary: the IFT cannot
-// move it) is outside Thm 19's setting: not available, with the reason. Example 3(b) with x0 =
-// 0.5, N_sim = 10 (the entry at t = 0.5; before this check Radau IIA gave 0 by R(inf) = 0 and
-// Gauss-Legendre 1), Example 3(a) with N_sim = 6 (t_s = 1/3; gave 1 instead of 1/3).
-TEST_P(IftSliding, SwitchOnAStepBoundaryIsNotAvailable) {
+// A sliding entry exactly on a step boundary (a fixed time, not a free element boundary: the IFT
+// cannot move it) gets the jump (24) with the sliding field f* (Prop. 9's remark): Example 3(b)
+// with x0 = 0.5, N_sim = 10 (the entry at t = 0.5): J = 1 + (0 - (-1)) / (-1) = 0, so 0 exactly
+// (before the jump: not available; before that check Radau IIA gave 0 by R(inf) = 0 and
+// Gauss-Legendre 1).
+TEST_P(IftSliding, SlidingEntryOnAStepBoundaryHasTheJump) {
   const Case c = GetParam();
   const fesd::Pss model = fesd::make_pss(
       Sliding{}, fesd::PssDims{.n_x = 1, .subsystems = {fesd::Subsystem::from_c(1)}});
-  const IntegratorResult sliding =
+  const IntegratorResult r =
       fesd::integrate(model, vec1(0.5), 1.0, 10, options(c.scheme, c.n_s, c.solver));
-  const IntegratorResult crossing =
-      fesd::integrate(crossing_model(), vec1(-1.0), 2.0, 6, options(c.scheme, c.n_s, c.solver));
-  for (const IntegratorResult* r : {&sliding, &crossing}) {
-    ASSERT_EQ(r->status, fesd::Status::Success) << r->message;
-    EXPECT_FALSE(r->sensitivities.available);
-    EXPECT_NE(r->sensitivities.message.find("lies on a step boundary"), std::string::npos)
-        << r->sensitivities.message;
+  expect_available(r);
+  ASSERT_EQ(r.switches.size(), 1u);
+  EXPECT_NEAR(r.switches[0].t, 0.5, 1e-12);
+  EXPECT_NEAR(r.sensitivities.x0(0, 0), 0.0, 1e-12);
+}
+
+// A sliding exit exactly on a step boundary is outside what is done (its jump needs the exit
+// condition's gradient): not available, with the reason. x1' in -sign(x1) + x2, x2' = 1 from
+// (0.3, -0.5) (tests/integrator/stepper_models.hpp): the exit at t = 1.5, step boundary 15 of 25
+// (where a path places the exit inside a step instead, the value must be the exact
+// [[0, 1], [0, 1]]: the slide forgets x1(0), and x1(T) = (T - t_e)^2 / 2 with t_e = 1 - x2(0)).
+TEST_P(IftSliding, SlidingExitOnAStepBoundaryIsNotAvailable) {
+  const Case c = GetParam();
+  const IntegratorResult r =
+      fesd::integrate(fesd_test::sliding_exit_model(), fesd_test::sliding_exit_x0(), 2.5, 25,
+                      options(c.scheme, c.n_s, c.solver));
+  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+  if (r.sensitivities.available) {
+    Eigen::Matrix2d exact;
+    exact << 0, 1, 0, 1;
+    EXPECT_LT((r.sensitivities.x0 - exact).lpNorm<Eigen::Infinity>(), 1e-6) << r.sensitivities.x0;
+  } else {
+    EXPECT_NE(r.sensitivities.message.find("lies on a step boundary"), std::string::npos)
+        << r.sensitivities.message;
   }
+}
+
+// A crossing exactly on a step boundary: the jump (24) is applied between the two steps
+// (Integrator::jump_at_step_start). Example 3(a) with N_sim = 6 (t_s = 1/3 on the boundary of
+// steps 1 and 2): 1/3 exactly (without the jump: 1, and before it was reported: not available).
+TEST_P(IftSliding, CrossingOnAStepBoundaryHasTheJump) {
+  const Case c = GetParam();
+  const IntegratorResult r =
+      fesd::integrate(crossing_model(), vec1(-1.0), 2.0, 6, options(c.scheme, c.n_s, c.solver));
+  expect_available(r);
+  ASSERT_EQ(r.switches.size(), 1u);
+  EXPECT_NEAR(r.switches[0].t, 1.0 / 3.0, 1e-12);
+  EXPECT_NEAR(r.sensitivities.x0(0, 0), 1.0 / 3.0, 1e-12);
 }
 INSTANTIATE_TEST_SUITE_P(Paths, IftSliding, ::testing::ValuesIn(kCases), case_name);
 
@@ -173,6 +205,36 @@ TEST(IftOscillator, ExactJumpMatrixProduct) {
     const double err = (r.sensitivities.x0 - exact).lpNorm<Eigen::Infinity>();
     // Radau IIA n_s = 3 (order 5), h = T / 100: measured 2.8e-7 on both paths against max |X| = 57.
     EXPECT_LT(err, 1e-6) << "error " << err << "\n" << r.sensitivities.x0;
+    RecordProperty(solver == StepSolver::ActiveSet ? "error_active_set" : "error_homotopy",
+                   fmt::format("{:.3e}", err));
+  }
+}
+
+// The oscillator with its crossing t_s = 1 on a step boundary (T = 1.5, N_sim = 60, h = 0.025).
+// The homotopy path keeps the switch at the boundary (t_s = 1 exactly): the jump J of (24) between
+// steps 40 and 41 gives e^(A2 (T - 1)) J e^(A1) to the scheme's error, measured 1.5e-7 against
+// max |X| = 39 (4.8e-6, 1.5e-7, 4.5e-9 at N_sim = 30, 60, 120: order 5; before: not available).
+// The active-set path's numerical crossing lands 1.7e-9 after the boundary, inside step 41 (a
+// first element of that length): no jump needed there, measured 1.6e-6 (N_sim = 61, the switch
+// inside a step: 2.2e-6 on both paths).
+TEST(IftOscillator, CrossingOnAStepBoundary) {
+  const double w = 2 * std::numbers::pi, T = 1.5;
+  Eigen::Matrix2d J;
+  J << 1, 0, 2 * w, 1;
+  const Eigen::Matrix2d exact = exp_rotation(1, -w, T - 1) * J * exp_rotation(1, w, 1);
+  for (StepSolver solver : {StepSolver::ActiveSet, StepSolver::Homotopy}) {
+    const IntegratorResult r =
+        fesd::integrate(fesd_bench::oscillator_model(), fesd_bench::oscillator_x0(), T, 60,
+                        options(RkScheme::RadauIIA, 3, solver));
+    expect_available(r);
+    ASSERT_EQ(r.switches.size(), 1u);
+    EXPECT_NEAR(r.switches[0].t, 1.0, 1e-8);
+    if (solver == StepSolver::Homotopy) {
+      EXPECT_NEAR(r.switches[0].t, 1.0, 1e-14);
+    }
+    const double err = (r.sensitivities.x0 - exact).lpNorm<Eigen::Infinity>();
+    EXPECT_LT(err, solver == StepSolver::Homotopy ? 1e-6 : 5e-6) << "error " << err << "\n"
+                                                                 << r.sensitivities.x0;
     RecordProperty(solver == StepSolver::ActiveSet ? "error_active_set" : "error_homotopy",
                    fmt::format("{:.3e}", err));
   }
