@@ -8,6 +8,7 @@
 #include <Eigen/Dense>
 
 #include "fesd/integrator.hpp"
+#include "fesd/ocp.hpp"
 #include "fesd/options.hpp"
 #include "fesd/pds.hpp"
 
@@ -37,6 +38,23 @@ PdsSimulationProblem load_pds_simulation_problem(const std::string& path);
 /// Same, from text; `source_name` is used in messages.
 PdsSimulationProblem parse_pds_simulation_problem(std::string_view toml_text,
                                                   std::string_view source_name);
+
+/// An optimal control problem of a projected system and its solver options, as read from a
+/// problem file with [model] kind = "projected" and an [ocp] table (docs/pds.md, "Optimal
+/// control"; the [ocp], [discretization], [homotopy] and [ipopt] keys of piecewise smooth OCP
+/// files). Solve it with fesd::solve(problem.ocp, problem.options).
+struct PdsOcpProblem {
+  std::string name;         ///< `name`, or the file's stem
+  std::string description;  ///< `description`, may be empty
+  std::string source;       ///< file path (or the name given to parse_pds_ocp_problem)
+  PdsOcp ocp;               ///< ocp.x0 and ocp.p from [model]
+  OcpOptions options;
+};
+
+/// Reads and validates a projected-system OCP file (errors as load_pds_simulation_problem).
+PdsOcpProblem load_pds_ocp_problem(const std::string& path);
+/// Same, from text; `source_name` is used in messages.
+PdsOcpProblem parse_pds_ocp_problem(std::string_view toml_text, std::string_view source_name);
 
 /// integrate() of the problem (N_sim steps).
 IntegratorResult simulate(const PdsSimulationProblem& problem);

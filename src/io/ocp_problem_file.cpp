@@ -23,9 +23,11 @@
 #include <toml++/toml.h>
 
 #include "fesd/error.hpp"
+#include "fesd/pds_problem_file.hpp"
 #include "fesd/problem_file.hpp"
 #include "io/ocp_expression_functions.hpp"
 #include "io/option_target.hpp"
+#include "io/pds_model_reader.hpp"
 #include "io/problem_file_reader.hpp"
 #include "ocp/ocp_input.hpp"
 
@@ -89,7 +91,8 @@ void complete_bounds(Bounds& b, int n, double lb_default, double ub_default) {
 }
 
 /// [discretization] N_finite_elements: one integer for all control intervals, or a list.
-void read_N_FE(const Reader& r, const toml::node& n, OcpProblem& problem) {
+template <class Problem>
+void read_N_FE(const Reader& r, const toml::node& n, Problem& problem) {
   const std::string path = "discretization.N_finite_elements";
   if (n.is_integer()) {
     problem.options.discretization.N_FE = r.integer(n, path);
@@ -108,7 +111,8 @@ void read_N_FE(const Reader& r, const toml::node& n, OcpProblem& problem) {
 /// The options of [ocp], [discretization], [homotopy] and [ipopt], then every input rule of the
 /// OCP (src/ocp/ocp_input.cpp): the problem's data first (ProblemFileError), then the options
 /// (InvalidOption), each message at the line of the key it names.
-void read_options(const Reader& r, const toml::table& root, OcpProblem& problem) {
+template <class Problem>
+void read_options(const Reader& r, const toml::table& root, Problem& problem) {
   const registry::OptionTarget target = target_of(problem);
   static constexpr std::array<std::string_view, 1> kPerInterval{"N_finite_elements"};
   for (registry::Table table : registry::tables(kKind)) {
@@ -132,40 +136,9 @@ Eigen::VectorXd append(const Eigen::VectorXd& v, double value) {
   return out;
 }
 
-}  // namespace
-
-OcpProblem parse_ocp_problem(std::string_view toml_text, std::string_view source_name) {
-  const Reader r{std::string(source_name)};
-  const toml::table root = parse_toml(toml_text, source_name);
-  const toml::node* ocp_node = root.get("ocp");
-  if (const toml::node* sim = root.get("simulation"))
-    r.fail(sim->source(), "simulation",
-           ocp_node != nullptr
-               ? "both [simulation] and [ocp] given (expected exactly one: [simulation] for a "
-                 "simulation, [ocp] for an optimal control problem)"
-               : "this is a simulation file (a [simulation] table, expected [ocp]): run it with "
-                 "`fesd simulate` or fesd::load_simulation_problem");
-  r.check_keys(root, kTopKeys, "");
-  if (ocp_node == nullptr)
-    r.fail(toml::source_region{}, "ocp",
-           "missing table [ocp] (expected at least T, the length of the horizon)");
-
-  OcpProblem problem;
-  read_name(r, root, source_name, problem);
-
-  ModelSpec spec = read_model_spec(r, root);
-  const Symbols sym = spec.sym;
-  const int n_x_user = static_cast<int>(sym.x.size());
-  const int n_u = static_cast<int>(sym.u.size());
-
-  // [ocp]: keys, then the expressions (they may read t, which decides the clock).
-  const toml::table& t = r.table(*ocp_node, "ocp");
-  if (const toml::node* x0 = t.get("x0"))
-    r.fail(x0->source(), "ocp.x0",
-           "x0 belongs in [model] (the initial state; with lbx0/ubx0 in [ocp] it is the guess of "
-           "a free initial state)");
-  check_table_keys(r, t, registry::Table::Ocp, kKind);
-  check_required_key(r, t, registry::Table::Ocp);
+/// The expressions of [ocp]: f_q, f_q_T, g_path, g_terminal (f_q_T and g_terminal without
+/// controls).
+OcpExpressions read_ocp_expressions(const Reader& r, const toml::table& t, const Symbols& sym) {
   OcpExpressions e;
   if (const toml::node* n = t.get("f_q")) e.f_q = r.expression(*n, "ocp.f_q", sym.all);
   if (const toml::node* n = t.get("f_q_T")) {
@@ -180,34 +153,15 @@ OcpProblem parse_ocp_problem(std::string_view toml_text, std::string_view source
     e.g_terminal = read_expressions(r, *g_terminal, "ocp.g_terminal", sym, false,
                                     "a terminal constraint g_terminal(x, p)");
 
-  const auto reads_time = [&](const expr::Expression& x) {
-    return sym.time_index >= 0 && x.depends_on(sym.time_index);
-  };
-  bool has_clock = spec.uses_time();
-  if (e.f_q) has_clock = has_clock || reads_time(*e.f_q);
-  if (e.f_q_T) has_clock = has_clock || reads_time(*e.f_q_T);
-  for (const auto* list : {&e.g_path, &e.g_terminal})
-    has_clock = has_clock || std::any_of(list->begin(), list->end(), reads_time);
+  return e;
+}
 
-  // [model] x0 and the Pss; the OCP starts at t = 0.
-  BuiltModel built = build_model(r, std::move(spec), has_clock, 0.0);
-  Ocp& ocp = problem.ocp;
-  ocp.model = std::move(built.model);
-  ocp.x0 = std::move(built.x0);
-  ocp.p = std::move(built.p);
-  problem.has_clock = has_clock;
-  ExpressionLayout layout;
-  layout.n_x = ocp.model.n_x();
-  layout.n_x_slots = n_x_user + (sym.time_index >= 0 ? 1 : 0);
-  layout.n_u = n_u;
-  layout.n_p = ocp.model.n_p();
-  ocp.n_g_path = static_cast<int>(e.g_path.size());
-  ocp.n_g_terminal = static_cast<int>(e.g_terminal.size());
-  // Its layout checks are invariants of this reader (fesd::InternalError), not input errors.
-  ocp.functions = std::make_shared<const ExpressionOcpFunctions>(layout, std::move(e));
-
-  // Bounds and guesses; their rules (lb <= ub, guesses within bounds) are checked with the
-  // options (read_options). The clock (if any) is unbounded and starts at 0.
+/// The bounds and guesses of [ocp] into `ocp` (n_x_user states in the file, a clock state
+/// appended if has_clock; n_u controls; the constraint counts already set). Their rules (lb <= ub,
+/// guesses within bounds) are checked with the options (read_options).
+void read_ocp_bounds(const Reader& r, const toml::table& t, int n_x_user, int n_u, bool has_clock,
+                     OcpData& ocp) {
+  // The clock (if any) is unbounded and starts at 0.
   const std::string per_state = "one per state in model.x";
   const std::string per_control = "one per control in model.u";
   Bounds x = read_bounds(r, t, "lbx", "ubx", n_x_user, per_state);
@@ -242,9 +196,124 @@ OcpProblem parse_ocp_problem(std::string_view toml_text, std::string_view source
   complete_bounds(gt, ocp.n_g_terminal, 0.0, 0.0);
   ocp.lbg_terminal = gt.lb;
   ocp.ubg_terminal = gt.ub;
+}
 
+}  // namespace
+
+OcpProblem parse_ocp_problem(std::string_view toml_text, std::string_view source_name) {
+  const Reader r{std::string(source_name)};
+  const toml::table root = parse_toml(toml_text, source_name);
+  const toml::node* ocp_node = root.get("ocp");
+  if (const toml::node* sim = root.get("simulation"))
+    r.fail(sim->source(), "simulation",
+           ocp_node != nullptr
+               ? "both [simulation] and [ocp] given (expected exactly one: [simulation] for a "
+                 "simulation, [ocp] for an optimal control problem)"
+               : "this is a simulation file (a [simulation] table, expected [ocp]): run it with "
+                 "`fesd simulate` or fesd::load_simulation_problem");
+  r.check_keys(root, kTopKeys, "");
+  if (ocp_node == nullptr)
+    r.fail(toml::source_region{}, "ocp",
+           "missing table [ocp] (expected at least T, the length of the horizon)");
+  if (const toml::node* m = root.get("model"); m != nullptr && m->as_table() != nullptr)
+    if (const toml::node* kind = m->as_table()->get("kind"))
+      r.fail(kind->source(), "model.kind",
+             "a projected model: read the file with fesd::load_pds_ocp_problem (`fesd solve` "
+             "does)");
+
+  OcpProblem problem;
+  read_name(r, root, source_name, problem);
+
+  ModelSpec spec = read_model_spec(r, root);
+  const Symbols sym = spec.sym;
+  const int n_x_user = static_cast<int>(sym.x.size());
+  const int n_u = static_cast<int>(sym.u.size());
+
+  // [ocp]: keys, then the expressions (they may read t, which decides the clock).
+  const toml::table& t = r.table(*ocp_node, "ocp");
+  if (const toml::node* x0 = t.get("x0"))
+    r.fail(x0->source(), "ocp.x0",
+           "x0 belongs in [model] (the initial state; with lbx0/ubx0 in [ocp] it is the guess of "
+           "a free initial state)");
+  check_table_keys(r, t, registry::Table::Ocp, kKind);
+  check_required_key(r, t, registry::Table::Ocp);
+  OcpExpressions e = read_ocp_expressions(r, t, sym);
+  const auto reads_time = [&](const expr::Expression& x) {
+    return sym.time_index >= 0 && x.depends_on(sym.time_index);
+  };
+  bool has_clock = spec.uses_time();
+  if (e.f_q) has_clock = has_clock || reads_time(*e.f_q);
+  if (e.f_q_T) has_clock = has_clock || reads_time(*e.f_q_T);
+  for (const auto* list : {&e.g_path, &e.g_terminal})
+    has_clock = has_clock || std::any_of(list->begin(), list->end(), reads_time);
+
+  // [model] x0 and the Pss; the OCP starts at t = 0.
+  BuiltModel built = build_model(r, std::move(spec), has_clock, 0.0);
+  Ocp& ocp = problem.ocp;
+  ocp.model = std::move(built.model);
+  ocp.x0 = std::move(built.x0);
+  ocp.p = std::move(built.p);
+  problem.has_clock = has_clock;
+  ExpressionLayout layout;
+  layout.n_x = ocp.model.n_x();
+  layout.n_x_slots = n_x_user + (sym.time_index >= 0 ? 1 : 0);
+  layout.n_u = n_u;
+  layout.n_p = ocp.model.n_p();
+  ocp.n_g_path = static_cast<int>(e.g_path.size());
+  ocp.n_g_terminal = static_cast<int>(e.g_terminal.size());
+  // Its layout checks are invariants of this reader (fesd::InternalError), not input errors.
+  ocp.functions = std::make_shared<const ExpressionOcpFunctions>(layout, std::move(e));
+
+  read_ocp_bounds(r, t, n_x_user, n_u, has_clock, ocp);
   read_options(r, root, problem);
   return problem;
+}
+
+PdsOcpProblem parse_pds_ocp_problem(std::string_view toml_text, std::string_view source_name) {
+  const Reader r{std::string(source_name)};
+  const toml::table root = parse_toml(toml_text, source_name);
+  const toml::node* ocp_node = root.get("ocp");
+  if (const toml::node* sim = root.get("simulation"))
+    r.fail(sim->source(), "simulation",
+           "a [simulation] table in an optimal control problem file (expected [ocp]; a "
+           "simulation file is run with `fesd simulate`)");
+  r.check_keys(root, kTopKeys, "");
+  if (ocp_node == nullptr)
+    r.fail(toml::source_region{}, "ocp",
+           "missing table [ocp] (expected at least T, the length of the horizon)");
+  PdsOcpProblem problem;
+  read_name(r, root, source_name, problem);
+  PdsModelRead m = read_pds_model(r, root);
+  const toml::table& t = r.table(*ocp_node, "ocp");
+  if (const toml::node* x0 = t.get("x0"))
+    r.fail(x0->source(), "ocp.x0", "x0 belongs in [model] (the initial state)");
+  check_table_keys(r, t, registry::Table::Ocp, kKind);
+  check_required_key(r, t, registry::Table::Ocp);
+  OcpExpressions e = read_ocp_expressions(r, t, m.sym);
+  const auto reads_time = [&](const expr::Expression& x) { return x.depends_on(m.sym.time_index); };
+  bool uses_time = (e.f_q && reads_time(*e.f_q)) || (e.f_q_T && reads_time(*e.f_q_T));
+  for (const auto* list : {&e.g_path, &e.g_terminal})
+    uses_time = uses_time || std::any_of(list->begin(), list->end(), reads_time);
+  if (uses_time)
+    r.fail(ocp_node->source(), "ocp",
+           "an expression uses the time t, which projected models do not support yet");
+  PdsOcp& ocp = problem.ocp;
+  ocp.model = std::move(m.model);
+  ocp.x0 = std::move(m.x0);
+  ocp.p = std::move(m.p);
+  const int n_x = ocp.model.n_x(), n_u = ocp.model.n_u();
+  const ExpressionLayout layout{
+      .n_x = n_x, .n_x_slots = n_x + 1, .n_u = n_u, .n_p = ocp.model.n_p()};
+  ocp.n_g_path = static_cast<int>(e.g_path.size());
+  ocp.n_g_terminal = static_cast<int>(e.g_terminal.size());
+  ocp.functions = std::make_shared<const ExpressionOcpFunctions>(layout, std::move(e));
+  read_ocp_bounds(r, t, n_x, n_u, /*has_clock=*/false, ocp);
+  read_options(r, root, problem);
+  return problem;
+}
+
+PdsOcpProblem load_pds_ocp_problem(const std::string& path) {
+  return parse_pds_ocp_problem(read_problem_text(path), path);
 }
 
 OcpProblem load_ocp_problem(const std::string& path) {
