@@ -56,6 +56,14 @@ PdsOcpProblem load_pds_ocp_problem(const std::string& path);
 /// Same, from text; `source_name` is used in messages.
 PdsOcpProblem parse_pds_ocp_problem(std::string_view toml_text, std::string_view source_name);
 
+/// Overrides one option of a projected file as if it had been written in the file (`fesd
+/// simulate/solve FILE --key value`): the registry options of its kind ([simulation] or [ocp],
+/// [discretization], [homotopy]), [ipopt] keys, model.x0, simulation.u / ocp.u_guess. Not yet:
+/// model.p, tol_sim, t0. Throws fesd::InvalidOption naming the key; on error the problem is
+/// unchanged.
+void apply_override(PdsSimulationProblem& problem, std::string_view key, std::string_view value);
+void apply_override(PdsOcpProblem& problem, std::string_view key, std::string_view value);
+
 /// integrate() of the problem (N_sim steps).
 IntegratorResult simulate(const PdsSimulationProblem& problem);
 

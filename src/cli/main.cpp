@@ -621,31 +621,37 @@ Problem prepare(const SolveArgs& args, const CLI::App& cmd) {
   return problem;
 }
 
-/// Plots and command-line overrides are not supported for projected models yet (exit 2).
+/// Plots are not supported for projected models yet (exit 2).
 void reject_pds_outputs(const SolveArgs& args, const CLI::App& cmd) {
   if (cmd.count("--plot") > 0)
     throw UsageError(
         "--plot is not supported for projected models ([model] kind = \"projected\") yet");
-  if (!args.overrides.pairs().empty())
-    throw UsageError(
-        "command-line overrides are not supported for projected models ([model] kind = "
-        "\"projected\") yet");
   check_outputs(args, cmd);
+}
+
+/// The first lines of the header of a projected file: name, source, what it is, sizes,
+/// description, x0 and the scheme.
+template <class Problem>
+void print_pds_header(const Problem& problem, std::string_view what, const std::string& sizes,
+                      const fesd::Pds& model, const Eigen::VectorXd& x0,
+                      const fesd::DiscretizationOptions& d) {
+  out::print("{} ({}): {}, n_x = {}, {}\n", problem.name, problem.source, what, model.n_x(), sizes);
+  if (!problem.description.empty()) out::print("  {}\n", problem.description);
+  out::print("  x0          {}\n", join_vector(x0, model.state_names));
+  out::print("  scheme      {}, n_s = {}, N_FE = {}, use_fesd = {}\n", fesd::to_string(d.rk_scheme),
+             d.n_s, d.N_FE, yes_no(d.use_fesd));
 }
 
 /// `fesd simulate` of a projected dynamical system ([model] kind = "projected", docs/pds.md): the
 /// header, integrate() and the report; --json and --csv as for piecewise smooth models.
 int run_simulate_pds(const SolveArgs& args, const CLI::App& cmd) {
   reject_pds_outputs(args, cmd);
-  const fesd::PdsSimulationProblem problem = fesd::load_pds_simulation_problem(args.file);
+  fesd::PdsSimulationProblem problem = fesd::load_pds_simulation_problem(args.file);
+  apply_overrides(problem, args.overrides);
   if (!args.quiet) {
-    const fesd::DiscretizationOptions& d = problem.options.discretization;
-    out::print("{} ({}): projected dynamical system, n_x = {}, n_c = {}\n", problem.name,
-               problem.source, problem.model.n_x(), problem.model.n_c());
-    if (!problem.description.empty()) out::print("  {}\n", problem.description);
-    out::print("  x0          {}\n", join_vector(problem.x0, problem.model.state_names));
-    out::print("  scheme      {}, n_s = {}, N_FE = {}, use_fesd = {}\n",
-               fesd::to_string(d.rk_scheme), d.n_s, d.N_FE, yes_no(d.use_fesd));
+    print_pds_header(problem, "projected dynamical system",
+                     fmt::format("n_c = {}", problem.model.n_c()), problem.model, problem.x0,
+                     problem.options.discretization);
     out::print("  simulation  T_sim = {:g}, N_sim = {}\n\n", problem.T_sim, problem.N_sim);
     flush_stdout();
   }
@@ -677,17 +683,12 @@ int run_simulate(const SolveArgs& args, const CLI::App& cmd) {
 int run_solve_pds(const SolveArgs& args, const CLI::App& cmd) {
   reject_pds_outputs(args, cmd);
   fesd::PdsOcpProblem problem = fesd::load_pds_ocp_problem(args.file);
+  apply_overrides(problem, args.overrides);
   const fesd::PdsOcp& ocp = problem.ocp;
   if (!args.quiet) {
-    const fesd::DiscretizationOptions& d = problem.options.discretization;
-    out::print(
-        "{} ({}): optimal control of a projected dynamical system, n_x = {}, n_u = {}, "
-        "n_c = {}\n",
-        problem.name, problem.source, ocp.model.n_x(), ocp.model.n_u(), ocp.model.n_c());
-    if (!problem.description.empty()) out::print("  {}\n", problem.description);
-    out::print("  x0          {}\n", join_vector(ocp.x0, ocp.model.state_names));
-    out::print("  scheme      {}, n_s = {}, N_FE = {}, use_fesd = {}\n",
-               fesd::to_string(d.rk_scheme), d.n_s, d.N_FE, yes_no(d.use_fesd));
+    print_pds_header(problem, "optimal control of a projected dynamical system",
+                     fmt::format("n_u = {}, n_c = {}", ocp.model.n_u(), ocp.model.n_c()), ocp.model,
+                     ocp.x0, problem.options.discretization);
     out::print("  ocp         T = {:g}, N_stages = {}\n\n", ocp.T, ocp.N_stages);
     flush_stdout();
     show_progress(problem.options);

@@ -312,6 +312,25 @@ PdsOcpProblem parse_pds_ocp_problem(std::string_view toml_text, std::string_view
   return problem;
 }
 
+void apply_override(PdsOcpProblem& problem, std::string_view key, std::string_view value) {
+  const OverrideArg arg = parse_override_arg(key, value, kKind);
+  PdsOcpProblem updated = problem;
+  if (set_scalar_override(arg, target_of(updated))) {
+    // One number for every control interval replaces a per-interval list.
+    if (arg.option->key == "N_finite_elements") updated.ocp.N_FE.clear();
+  } else if (arg.option != nullptr && arg.option->key == "u_guess") {
+    updated.ocp.u_guess = override_vector(arg.head, arg.value, updated.ocp.model.n_u(),
+                                          "ocp.u_guess", "one per control in model.u");
+  } else if (!set_pds_override(arg, updated.ocp.model.n_x(), updated.ocp.model.n_u(),
+                               updated.options.nlp.extra, updated.ocp.x0, nullptr)) {
+    unknown_override(arg, kKind, Pss{});
+  }
+  ocp_detail::OcpInputErrors errors = ocp_detail::check_input(updated.ocp, updated.options);
+  for (std::string& e : errors.data) errors.options.push_back(std::move(e));
+  if (!errors.options.empty()) throw_override_errors(arg, errors.options);
+  problem = std::move(updated);
+}
+
 PdsOcpProblem load_pds_ocp_problem(const std::string& path) {
   return parse_pds_ocp_problem(read_problem_text(path), path);
 }

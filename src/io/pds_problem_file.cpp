@@ -225,4 +225,50 @@ IntegratorResult simulate(const PdsSimulationProblem& q) {
   return integrate(q.model, q.x0, q.T_sim, q.N_sim, q.options, q.u, q.p, q.pds);
 }
 
+namespace io_detail {
+
+bool set_pds_override(const OverrideArg& a, int n_x, int n_u,
+                      std::vector<std::pair<std::string, std::string>>& ipopt_extra,
+                      Eigen::VectorXd& x0, Eigen::VectorXd* u) {
+  const std::string_view key = a.option != nullptr ? a.option->key : a.key;
+  if (a.table == "ipopt" && !a.key.empty()) {
+    set_ipopt_option(ipopt_extra, a.key, a.value);
+  } else if ((a.table.empty() || a.table == "model") && a.key == "x0") {
+    x0 = override_vector(a.head, a.value, n_x, "model.x0", "one per state");
+  } else if (u != nullptr && key == "u") {
+    *u = override_vector(a.head, a.value, n_u, "simulation.u", "one per control");
+  } else if (key == "tol_sim" || key == "t0" || (a.table.empty() && a.key == "p")) {
+    throw InvalidOption(fmt::format("{}: not supported for projected models yet", a.head));
+  } else {
+    return false;
+  }
+  return true;
+}
+
+}  // namespace io_detail
+
+void apply_override(PdsSimulationProblem& problem, std::string_view key, std::string_view value) {
+  const OverrideArg arg = parse_override_arg(key, value, kKind);
+  // The registry writes into the fields of a SimulationProblem (as when reading the file).
+  SimulationProblem s;
+  s.options = problem.options;
+  s.T_sim = problem.T_sim;
+  s.N_sim = problem.N_sim;
+  PdsSimulationProblem updated = problem;
+  if (!set_scalar_override(arg, target_of(s)) &&
+      !set_pds_override(arg, updated.model.n_x(), updated.model.n_u(), s.options.nlp.extra,
+                        updated.x0, &updated.u))
+    unknown_override(arg, kKind, Pss{});
+  if (s.tol_sim > 0)
+    override_error(arg.head, "not supported for projected models yet (give N_sim)");
+  updated.options = s.options;
+  updated.T_sim = s.T_sim;
+  updated.N_sim = s.N_sim;
+  std::vector<std::string> errors = registry::validate_simulation(updated.T_sim, updated.N_sim);
+  for (std::string& e : validate(updated.options)) errors.push_back(std::move(e));
+  if (updated.N_sim < 1) errors.push_back("simulation.N_sim: must be >= 1 for projected models");
+  if (!errors.empty()) throw_override_errors(arg, errors);
+  problem = std::move(updated);
+}
+
 }  // namespace fesd

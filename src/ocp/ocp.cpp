@@ -647,14 +647,8 @@ OcpResult solve_impl(const Ocp& ocp, const OcpOptions& options, const std::vecto
       *applied = force_allocation(*b, ocp, options, p, *solver, account, hr, *count, res.summary);
     report_held_switches(*b, mp.solution(), res.summary);
   }
-  res.status = hr.status;
-  res.comp_residual = hr.comp_residual;
-  res.summary.max_comp_residual = hr.comp_residual;
+  ocp_detail::set_outcome(hr, res);
   extract(*b, ocp, mp.solution(), p, res);
-  res.message = res.status == Status::Success
-                    ? std::string(describe(Status::Success))
-                    : fmt::format("{} (last IPOPT status {}, complementarity residual {:.2e})",
-                                  describe(hr.status), hr.last_nlp_status, hr.comp_residual);
   if (options.initialization == OcpInitialization::Simulation && !simulated)
     res.message += " [the initializing simulation failed or used another grid: constant guess]";
   res.summary.wall_s = seconds_since(t_start);

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
 #include <Eigen/Dense>
 
 #include "core/util.hpp"
@@ -303,6 +304,17 @@ void extract_result(const OcpData& ocp, const Tableau& tab, int n_x, int n_u,
   }
   res.t_ctrl.push_back(ocp.T);
   res.objective = objective.total(res.x.back(), w, terminal_slacks);
+}
+
+/// The outcome of the homotopy in the result: status, complementarity residual, message.
+inline void set_outcome(const mpcc::HomotopyResult& hr, OcpResult& res) {
+  res.status = hr.status;
+  res.comp_residual = hr.comp_residual;
+  res.summary.max_comp_residual = hr.comp_residual;
+  res.message = res.status == Status::Success
+                    ? std::string(describe(Status::Success))
+                    : fmt::format("{} (last IPOPT status {}, complementarity residual {:.2e})",
+                                  describe(hr.status), hr.last_nlp_status, hr.comp_residual);
 }
 
 }  // namespace fesd::ocp_detail

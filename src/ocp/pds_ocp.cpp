@@ -133,14 +133,8 @@ OcpResult solve(const PdsOcp& ocp, const OcpOptions& options) {
           "the re-solve with the active sets fixed failed: the homotopy's solution stays");
     }
   }
-  res.status = hr.status;
-  res.comp_residual = hr.comp_residual;
-  res.summary.max_comp_residual = hr.comp_residual;
+  ocp_detail::set_outcome(hr, res);
   extract(*b, ocp, mp.solution(), p, res);
-  res.message = res.status == Status::Success
-                    ? std::string(describe(Status::Success))
-                    : fmt::format("{} (last IPOPT status {}, complementarity residual {:.2e})",
-                                  describe(hr.status), hr.last_nlp_status, hr.comp_residual);
   res.summary.wall_s = seconds_since(t_start);
   return res;
 }

@@ -8,6 +8,8 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -163,13 +165,50 @@ TEST(PdsCli, SimulateExample1Json) {
       << json.substr(0, 400);
 }
 
-TEST(PdsCli, UnsupportedOutputsAndOverridesExitTwo) {
+TEST(PdsCli, PlotExitsTwo) {
   const std::string file = std::string(FESD_SOURCE_DIR) + "/examples/pds_example1.toml";
-  for (const std::string& extra : {std::string("--plot /tmp/x.png"), std::string("--n_s 2")}) {
-    const CliRun r = fesd_cli(file + " " + extra);
-    EXPECT_EQ(r.code, 2) << extra;
-    EXPECT_NE(r.err.find("not supported for projected models"), std::string::npos) << r.err;
+  const CliRun r = fesd_cli(file + " --plot /tmp/x.png");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("not supported for projected models"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+}
+
+// Bad projected files through the program: exit 2 and one line naming the problem.
+TEST(PdsCli, BadFilesExitTwoWithOneLine) {
+  TempDir dir;
+  const std::string file = dir.file("bad.toml");
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {replace(kExample1, "f = [", "fx = ["), "unknown key 'fx'"},
+      {replace(kExample1, "f = [\"x2\", \"-x1\"]", "f = [\"x2\"]"), "model.f: wrong length"},
+      {replace(kExample1, "x0 = [1.4142135623730951, ", "x0 = [nan, "), "must be finite"},
+      {replace(kExample1, "x0 = [1.4142135623730951, 1.4142135623730951]", "x0 = [0.0, -2.0]"),
+       "outside C"},
+      {replace(kExample1, "N_sim = 1", "N_sim = 1\nbogus = 2"), "unknown key 'bogus'"}};
+  for (const auto& [text, what] : cases) {
+    {
+      std::ofstream f(file);
+      f << text;
+    }
+    const CliRun r = fesd_cli("'" + file + "' --quiet");
+    EXPECT_EQ(r.code, 2) << what;
+    EXPECT_NE(r.err.find(what), std::string::npos) << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
+}
+
+// Command-line overrides as for piecewise smooth files; unknown and unsupported keys: exit 2.
+TEST(PdsCli, Overrides) {
+  const std::string file = std::string(FESD_SOURCE_DIR) + "/examples/pds_example1.toml";
+  const CliRun ok =
+      fesd_cli(file + " --n_s 2 --N_FE 10 --x0 1.4142135623730951,1.4142135623730951");
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  EXPECT_NE(ok.out.find("n_s = 2, N_FE = 10"), std::string::npos) << ok.out;
+  for (const std::string& extra :
+       {std::string("--n_S 2"), std::string("--p a=2"), std::string("--tol_sim 1e-3"),
+        std::string("--x0 1,2,3"), std::string("--N_sim 0")}) {
+    const CliRun r = fesd_cli(file + " " + extra);
+    EXPECT_EQ(r.code, 2) << extra << r.out;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << extra << ": " << r.err;
   }
 }
 
@@ -314,6 +353,11 @@ TEST(PdsCli, SolveWall) {
   EXPECT_NE(json.find("\"objective\""), std::string::npos);
   EXPECT_NE(json.find("\"switches\""), std::string::npos);
   EXPECT_NE(json.find("\"control_names\": [\"u\"]"), std::string::npos);
+  // An override: 8 control intervals of 2 elements.
+  const CliRun more = fesd_cli("'" + wall + "' --N_stages 8 --csv '" + csv_file + "'", "solve");
+  ASSERT_EQ(more.code, 0) << more.err;
+  const std::string csv8 = slurp(csv_file);
+  EXPECT_EQ(std::count(csv8.begin(), csv8.end(), '\n'), 18);  // header + 17 element boundaries
   // x0 outside C: bad input, one line, exit 2.
   {
     std::ofstream f(bad_file);
