@@ -53,14 +53,8 @@ std::vector<int> intervals_N_FE(const Ocp& ocp, const OcpOptions& o) {
 // ---- the NLP -----------------------------------------------------------------------------------
 
 /// The MPCC of the OCP (59)-(60) and where its pieces live.
-struct OcpNlp {
-  mpcc::Problem mpcc;
-  Tableau tab;
-  std::vector<int> s0, p;
-  std::vector<std::vector<int>> q;  // per interval
-  std::vector<std::unique_ptr<FesdInterval>> iv;
+struct OcpNlp : ocp_detail::OcpNlpParts<FesdInterval> {
   std::vector<IntervalInputs> in;
-  std::vector<int> terminal_slacks;
 };
 
 std::unique_ptr<OcpNlp> build(const Ocp& ocp, const OcpOptions& o, const Eigen::VectorXd& p) {

@@ -107,6 +107,20 @@ struct TerminalConstraintEq {
 std::vector<std::string> cost_block_size_errors(const OcpData& ocp, int n_x, int n_u, int n_p,
                                                 int n_s);
 
+// ---- the NLP -----------------------------------------------------------------------------------
+
+/// The MPCC of an OCP and where its pieces live, for one interval type (FesdInterval,
+/// PdsInterval).
+template <class Interval>
+struct OcpNlpParts {
+  mpcc::Problem mpcc;
+  Tableau tab;
+  std::vector<int> s0, p;
+  std::vector<std::vector<int>> q;  // per interval
+  std::vector<std::unique_ptr<Interval>> iv;
+  std::vector<int> terminal_slacks;
+};
+
 // ---- decision variables ------------------------------------------------------------------------
 
 /// s0 (fixed to x0, or free within [lbx0, ubx0] intersected with [lbx, ubx]) and p (fixed).

@@ -28,14 +28,7 @@ using util::seconds_since;
 using Clock = std::chrono::steady_clock;
 
 /// The MPCC of a PDS OCP and where its pieces live.
-struct PdsOcpNlp {
-  mpcc::Problem mpcc;
-  Tableau tab;
-  std::vector<int> s0, p;
-  std::vector<std::vector<int>> q;  // per interval
-  std::vector<std::unique_ptr<PdsInterval>> iv;
-  std::vector<int> terminal_slacks;
-};
+using PdsOcpNlp = ocp_detail::OcpNlpParts<PdsInterval>;
 
 std::unique_ptr<PdsOcpNlp> build(const PdsOcp& ocp, const OcpOptions& o, const Eigen::VectorXd& p) {
   const Pds& m = ocp.model;
