@@ -6,6 +6,7 @@
 #include "fesd/integrator.hpp"
 #include "fesd/model.hpp"
 #include "fesd/ocp.hpp"
+#include "fesd/pds.hpp"
 
 namespace fesd {
 
@@ -46,6 +47,14 @@ void write_csv(const OcpResult& result, const Pss& model, const std::string& pat
 /// fesd::IoError.
 void write_plot(const OcpResult& result, const Pss& model, const std::string& path,
                 const std::string& title = "");
+
+/// The same JSON and CSV for projected dynamical systems (docs/pds.md): "lambda" holds the PDS
+/// multipliers, "theta" and "mu" are empty, "active_set" lists the active constraints, "switches"
+/// are contact and leaving events (regions = constraints).
+void write_json(const IntegratorResult& result, const Pds& model, const std::string& path);
+void write_csv(const IntegratorResult& result, const Pds& model, const std::string& path);
+void write_json(const OcpResult& result, const Pds& model, const std::string& path);
+void write_csv(const OcpResult& result, const Pds& model, const std::string& path);
 
 /// Throws fesd::IoError if gnuplot, which write_plot runs, is not on PATH: lets a front end fail
 /// before a long solve instead of after it. write_plot checks this itself.

@@ -42,6 +42,7 @@
 #include "fesd/integrator.hpp"
 #include "fesd/model.hpp"
 #include "fesd/options.hpp"
+#include "fesd/pds.hpp"
 #include "fesd/status.hpp"
 #include "fesd/summary.hpp"
 
@@ -74,9 +75,9 @@ enum class TerminalConstraint {
 std::string_view to_string(TerminalConstraint v);
 bool parse(std::string_view name, TerminalConstraint& out);
 
-/// An optimal control problem. Vectors left empty mean "none" (bounds) or "zero" (guesses).
-struct Ocp {
-  Pss model;
+/// Everything of an optimal control problem but its dynamics (shared by Ocp and PdsOcp). Vectors
+/// left empty mean "none" (bounds) or "zero" (guesses).
+struct OcpData {
   std::shared_ptr<const OcpFunctions> functions;  ///< costs and constraints; may be null
   double T = 0;                                   ///< horizon (nosnoc: T), > 0
   int N_stages = 1;  ///< control intervals of equal length (nosnoc: N_stages)
@@ -106,6 +107,19 @@ struct Ocp {
   Eigen::VectorXd lbg_terminal, ubg_terminal;
   TerminalConstraint terminal_constraint = TerminalConstraint::Hard;
   double rho_terminal = 1e3;  ///< weight of the l1 terminal penalty, > 0
+};
+
+/// An optimal control problem of a piecewise smooth system (Filippov paper, Sect. 5).
+struct Ocp : OcpData {
+  Pss model;
+};
+
+/// An optimal control problem of a projected dynamical system (papers/fesd-pds.txt Sect. II-D,
+/// III-D; docs/pds.md "Optimal control"): the same costs, bounds and constraints, each control
+/// interval one PDS FESD interval (src/discretization/pds_interval.hpp).
+struct PdsOcp : OcpData {
+  Pds model;
+  PdsOptions pds;  ///< big_M and h_penalty of the PDS step equilibration
 };
 
 /// Initial guess of the states (nosnoc: initialization).
@@ -178,6 +192,16 @@ struct OcpResult {
 /// Solves the OCP. Throws fesd::InvalidModel / InvalidOption for bad input (dimensions, NaN,
 /// options out of range); a solver failure is a status in the result.
 OcpResult solve(const Ocp& ocp, const OcpOptions& options);
+
+/// Solves an OCP of a projected dynamical system: per control interval the FESD discretization of
+/// papers/fesd-pds.txt (6), (8) and Sect. III-C (Radau IIA with n_s >= 2 or the standard method),
+/// the MPCC homotopy of `options.homotopy`, then one re-solve with the active set of every element
+/// fixed (HomotopyOptions::fix_active_set). The result: `lambda` holds the PDS multipliers (n_c
+/// per stage), `theta` and `eta` stay empty, `active_set` lists the active constraints per
+/// element, `switches` are contact and leaving events. Not used for PDS: the Stewart-specific
+/// post-processing (sliding-exit pins, the allocation search, active_set_sigma) and
+/// initialization = simulation (the guess is x0 everywhere). Throws like solve(const Ocp&, ...).
+OcpResult solve(const PdsOcp& ocp, const OcpOptions& options);
 
 namespace detail {
 template <class F>

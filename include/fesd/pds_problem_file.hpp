@@ -8,8 +8,10 @@
 #include <Eigen/Dense>
 
 #include "fesd/integrator.hpp"
+#include "fesd/ocp.hpp"
 #include "fesd/options.hpp"
 #include "fesd/pds.hpp"
+#include "fesd/problem_file.hpp"
 
 namespace fesd {
 
@@ -37,6 +39,34 @@ PdsSimulationProblem load_pds_simulation_problem(const std::string& path);
 /// Same, from text; `source_name` is used in messages.
 PdsSimulationProblem parse_pds_simulation_problem(std::string_view toml_text,
                                                   std::string_view source_name);
+
+/// An optimal control problem of a projected system and its solver options, as read from a
+/// problem file with [model] kind = "projected" and an [ocp] table (docs/pds.md, "Optimal
+/// control"; the [ocp], [discretization], [homotopy] and [ipopt] keys of piecewise smooth OCP
+/// files). Solve it with fesd::solve(problem.ocp, problem.options).
+struct PdsOcpProblem {
+  std::string name;         ///< `name`, or the file's stem
+  std::string description;  ///< `description`, may be empty
+  std::string source;       ///< file path (or the name given to parse_pds_ocp_problem)
+  PdsOcp ocp;               ///< ocp.x0 and ocp.p from [model]
+  OcpOptions options;
+};
+
+/// Reads and validates a projected-system OCP file (errors as load_pds_simulation_problem).
+PdsOcpProblem load_pds_ocp_problem(const std::string& path);
+/// Same, from text; `source_name` is used in messages.
+PdsOcpProblem parse_pds_ocp_problem(std::string_view toml_text, std::string_view source_name);
+
+/// Overrides one option of a projected file as if it had been written in the file (`fesd
+/// simulate/solve FILE --key value`): the registry options of its kind ([simulation] or [ocp],
+/// [discretization], [homotopy]), [ipopt] keys, model.x0, simulation.u / ocp.u_guess. Not yet:
+/// model.p, tol_sim, t0. Throws fesd::InvalidOption naming the key; on error the problem is
+/// unchanged.
+void apply_override(PdsSimulationProblem& problem, std::string_view key, std::string_view value);
+void apply_override(PdsOcpProblem& problem, std::string_view key, std::string_view value);
+/// Several overrides, retried in the order fesd::apply_overrides (problem_file.hpp) uses.
+void apply_overrides(PdsSimulationProblem& problem, const OverrideList& overrides);
+void apply_overrides(PdsOcpProblem& problem, const OverrideList& overrides);
 
 /// integrate() of the problem (N_sim steps).
 IntegratorResult simulate(const PdsSimulationProblem& problem);

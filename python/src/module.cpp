@@ -79,18 +79,10 @@ struct Problem {
   }
 };
 
-/// Overrides of a problem (fesd::apply_overrides); projected models take none yet (as in the
-/// program).
+/// Overrides of a problem, as the program applies them (fesd::apply_overrides).
 template <class P>
 void apply_problem_overrides(P& problem, const Overrides& overrides) {
-  if constexpr (std::is_same_v<P, fesd::PdsSimulationProblem>) {
-    if (!overrides.empty())
-      throw fesd::InvalidOption(
-          "option overrides are not supported for projected models ([model] kind = "
-          "\"projected\") yet");
-  } else {
-    fesd::apply_overrides(problem, overrides);
-  }
+  fesd::apply_overrides(problem, overrides);
 }
 
 py::array_t<double> vector_array(const std::vector<double>& v) {

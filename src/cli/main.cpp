@@ -528,8 +528,8 @@ void check_outputs(const SolveArgs& args, const CLI::App& cmd) {
 
 /// Prints the report, writes the outputs that were asked for (also after a numerical failure,
 /// then saying so) and returns the exit code. `what` names the run in the failure message.
-template <class Result>
-int finish(const Result& result, const std::string& report, const fesd::Pss& model,
+template <class Result, class Model>
+int finish(const Result& result, const std::string& report, const Model& model,
            const std::string& title, const SolveArgs& args, const CLI::App& cmd, const char* what) {
   std::fflush(stderr);
   out::print("{}", report);
@@ -550,7 +550,8 @@ int finish(const Result& result, const std::string& report, const fesd::Pss& mod
   };
   write("--json", args.json, "JSON", [&] { fesd::write_json(result, model, args.json); });
   write("--csv", args.csv, "CSV ", [&] { fesd::write_csv(result, model, args.csv); });
-  write("--plot", args.plot, "plot", [&] { fesd::write_plot(result, model, args.plot, title); });
+  if constexpr (std::is_same_v<Model, fesd::Pss>)  // projected models: rejected before solving
+    write("--plot", args.plot, "plot", [&] { fesd::write_plot(result, model, args.plot, title); });
   flush_stdout();
 
   if (!io_errors.empty()) {
@@ -597,51 +598,42 @@ Problem prepare(const SolveArgs& args, const CLI::App& cmd) {
   return problem;
 }
 
-/// `fesd simulate` of a projected dynamical system ([model] kind = "projected", docs/pds.md): the
-/// header, integrate() and the report; --csv writes t and x at the element boundaries. JSON,
-/// plots and command-line overrides are not supported for these models yet (exit 2).
-int run_simulate_pds(const SolveArgs& args, const CLI::App& cmd) {
-  for (const char* option : {"--json", "--plot"})
-    if (cmd.count(option) > 0)
-      throw UsageError(fmt::format(
-          "{} is not supported for projected models ([model] kind = \"projected\") yet", option));
-  if (!args.overrides.pairs().empty())
+/// Plots are not supported for projected models yet (exit 2).
+void reject_pds_outputs(const SolveArgs& args, const CLI::App& cmd) {
+  if (cmd.count("--plot") > 0)
     throw UsageError(
-        "command-line overrides are not supported for projected models ([model] kind = "
-        "\"projected\") yet");
-  const fesd::PdsSimulationProblem problem = fesd::load_pds_simulation_problem(args.file);
+        "--plot is not supported for projected models ([model] kind = \"projected\") yet");
+  check_outputs(args, cmd);
+}
+
+/// The first lines of the header of a projected file: name, source, what it is, sizes,
+/// description, x0 and the scheme.
+template <class Problem>
+void print_pds_header(const Problem& problem, std::string_view what, const std::string& sizes,
+                      const fesd::Pds& model, const Eigen::VectorXd& x0,
+                      const fesd::DiscretizationOptions& d) {
+  out::print("{} ({}): {}, n_x = {}, {}\n", problem.name, problem.source, what, model.n_x(), sizes);
+  if (!problem.description.empty()) out::print("  {}\n", problem.description);
+  out::print("  x0          {}\n", join_vector(x0, model.state_names));
+  out::print("  scheme      {}, n_s = {}, N_FE = {}, use_fesd = {}\n", fesd::to_string(d.rk_scheme),
+             d.n_s, d.N_FE, yes_no(d.use_fesd));
+}
+
+/// `fesd simulate` of a projected dynamical system ([model] kind = "projected", docs/pds.md): the
+/// header, integrate() and the report; --json and --csv as for piecewise smooth models.
+int run_simulate_pds(const SolveArgs& args, const CLI::App& cmd) {
+  reject_pds_outputs(args, cmd);
+  fesd::PdsSimulationProblem problem = fesd::load_pds_simulation_problem(args.file);
+  fesd::apply_overrides(problem, args.overrides.pairs());
   if (!args.quiet) {
-    const fesd::DiscretizationOptions& d = problem.options.discretization;
-    out::print("{} ({}): projected dynamical system, n_x = {}, n_c = {}\n", problem.name,
-               problem.source, problem.model.n_x(), problem.model.n_c());
-    if (!problem.description.empty()) out::print("  {}\n", problem.description);
-    out::print("  x0          {}\n", join_vector(problem.x0, problem.model.state_names));
-    out::print("  scheme      {}, n_s = {}, N_FE = {}, use_fesd = {}\n",
-               fesd::to_string(d.rk_scheme), d.n_s, d.N_FE, yes_no(d.use_fesd));
+    print_pds_header(problem, "projected dynamical system",
+                     fmt::format("n_c = {}", problem.model.n_c()), problem.model, problem.x0,
+                     problem.options.discretization);
     out::print("  simulation  T_sim = {:g}, N_sim = {}\n\n", problem.T_sim, problem.N_sim);
     flush_stdout();
   }
   const fesd::IntegratorResult result = fesd::simulate(problem);
-  out::print("{}\n", result.full_report());
-  if (cmd.count("--csv") > 0) {
-    std::ofstream f(args.csv);
-    if (!f) throw fesd::IoError(fmt::format("{}: cannot write CSV", args.csv));
-    f << "t";
-    for (const std::string& name : problem.model.state_names) f << "," << name;
-    f << "\n";
-    for (std::size_t n = 0; n < result.t.size(); ++n) {
-      f << fmt::format("{:.17g}", result.t[n]);
-      for (Eigen::Index i = 0; i < result.x[n].size(); ++i)
-        f << fmt::format(",{:.17g}", result.x[n][i]);
-      f << "\n";
-    }
-    if (!f) throw fesd::IoError(fmt::format("{}: cannot write CSV", args.csv));
-    out::print("wrote CSV  {}\n", args.csv);
-  }
-  if (result.status != fesd::Status::Success)
-    print_error(fmt::format("the simulation failed ({}): {}", fesd::to_string(result.status),
-                            result.message));
-  return fesd::exit_code(result.status);
+  return finish(result, result.full_report(), problem.model, problem.name, args, cmd, "simulation");
 }
 
 int run_simulate(const SolveArgs& args, const CLI::App& cmd) {
@@ -662,7 +654,31 @@ int run_simulate(const SolveArgs& args, const CLI::App& cmd) {
   return finish(result, result.full_report(), problem.model, problem.name, args, cmd, "simulation");
 }
 
+/// `fesd solve` of a projected dynamical system (docs/pds.md, "Optimal control"): the header, the
+/// homotopy table as progress, solve() and the report; --json and --csv as for piecewise smooth
+/// OCPs.
+int run_solve_pds(const SolveArgs& args, const CLI::App& cmd) {
+  reject_pds_outputs(args, cmd);
+  fesd::PdsOcpProblem problem = fesd::load_pds_ocp_problem(args.file);
+  fesd::apply_overrides(problem, args.overrides.pairs());
+  const fesd::PdsOcp& ocp = problem.ocp;
+  if (!args.quiet) {
+    print_pds_header(problem, "optimal control of a projected dynamical system",
+                     fmt::format("n_u = {}, n_c = {}", ocp.model.n_u(), ocp.model.n_c()), ocp.model,
+                     ocp.x0, problem.options.discretization);
+    out::print("  ocp         T = {:g}, N_stages = {}\n\n", ocp.T, ocp.N_stages);
+    flush_stdout();
+    show_progress(problem.options);
+  }
+  const fesd::OcpResult result = fesd::solve(ocp, problem.options);
+  // The homotopy table is the progress output (none with --quiet): not repeated in the report.
+  return finish(result, result.full_report(/*with_homotopy_table=*/false), ocp.model, problem.name,
+                args, cmd, "optimal control problem");
+}
+
 int run_solve(const SolveArgs& args, const CLI::App& cmd) {
+  check_input_file(args.file);
+  if (fesd::is_projected_problem_file(args.file)) return run_solve_pds(args, cmd);
   const auto problem = prepare<fesd::OcpProblem>(args, cmd);
   const fesd::OcpResult result = fesd::solve(problem.ocp, problem.options);
   // The homotopy table is the progress output (none with --quiet): not repeated in the report.

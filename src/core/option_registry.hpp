@@ -16,7 +16,7 @@
 #include "fesd/options.hpp"
 
 namespace fesd {
-struct Ocp;
+struct OcpData;
 struct OcpOptions;
 enum class TerminalConstraint;
 enum class OcpInitialization;
@@ -50,7 +50,7 @@ struct OptionTarget {
   bool* error_estimate = nullptr;     ///< simulate()'s companion runs (AccuracyOptions)
   StepSolver* step_solver = nullptr;  ///< IntegratorOptions::step_solver
   bool* sensitivities = nullptr;      ///< IntegratorOptions::sensitivities
-  Ocp* ocp = nullptr;                 ///< [ocp] keys stored in the problem
+  OcpData* ocp = nullptr;             ///< [ocp] keys stored in the problem
   OcpOptions* ocp_options = nullptr;  ///< [ocp] keys stored in the solver options
 };
 

@@ -236,7 +236,8 @@ std::vector<std::string> names_of(const std::vector<std::string>& given,
   return names;
 }
 
-std::vector<std::string> state_names_of(const IntegratorResult& result, const Pss& model) {
+template <class Model>
+std::vector<std::string> state_names_of(const IntegratorResult& result, const Model& model) {
   return names_of(model.state_names, result.x, model.n_x(), 'x');
 }
 
@@ -254,7 +255,10 @@ void write_output_file(const std::string& path, const std::string& content) {
 
 }  // namespace
 
-void write_json(const IntegratorResult& result, const Pss& model, const std::string& path) {
+// The writers need only the model's names and sizes: one template for Pss and Pds.
+template <class Model>
+void json_of_simulation(const IntegratorResult& result, const Model& model,
+                        const std::string& path) {
   json j;
   j["status"] = std::string(to_string(result.status));
   j["message"] = result.message;
@@ -306,7 +310,9 @@ void append_csv_state_row(std::string& out, double t, const Eigen::VectorXd& x) 
 
 }  // namespace
 
-void write_csv(const IntegratorResult& result, const Pss& model, const std::string& path) {
+template <class Model>
+void csv_of_simulation(const IntegratorResult& result, const Model& model,
+                       const std::string& path) {
   const std::vector<std::string> names = state_names_of(result, model);
   std::string out = "t";
   append_csv_names(out, names);
@@ -319,7 +325,8 @@ void write_csv(const IntegratorResult& result, const Pss& model, const std::stri
   write_output_file(path, out);
 }
 
-void write_json(const OcpResult& result, const Pss& model, const std::string& path) {
+template <class Model>
+void json_of_ocp(const OcpResult& result, const Model& model, const std::string& path) {
   json j;
   j["status"] = std::string(to_string(result.status));
   j["message"] = result.message;
@@ -357,7 +364,8 @@ void write_json(const OcpResult& result, const Pss& model, const std::string& pa
   write_output_file(path, text);
 }
 
-void write_csv(const OcpResult& result, const Pss& model, const std::string& path) {
+template <class Model>
+void csv_of_ocp(const OcpResult& result, const Model& model, const std::string& path) {
   const std::vector<std::string> states = names_of(model.state_names, result.x, model.n_x(), 'x');
   const std::vector<std::string> controls =
       names_of(model.control_names, result.u, model.n_u(), 'u');
@@ -388,6 +396,31 @@ void write_csv(const OcpResult& result, const Pss& model, const std::string& pat
     out += '\n';
   }
   write_output_file(path, out);
+}
+
+void write_json(const IntegratorResult& result, const Pss& model, const std::string& path) {
+  json_of_simulation(result, model, path);
+}
+void write_json(const IntegratorResult& result, const Pds& model, const std::string& path) {
+  json_of_simulation(result, model, path);
+}
+void write_csv(const IntegratorResult& result, const Pss& model, const std::string& path) {
+  csv_of_simulation(result, model, path);
+}
+void write_csv(const IntegratorResult& result, const Pds& model, const std::string& path) {
+  csv_of_simulation(result, model, path);
+}
+void write_json(const OcpResult& result, const Pss& model, const std::string& path) {
+  json_of_ocp(result, model, path);
+}
+void write_json(const OcpResult& result, const Pds& model, const std::string& path) {
+  json_of_ocp(result, model, path);
+}
+void write_csv(const OcpResult& result, const Pss& model, const std::string& path) {
+  csv_of_ocp(result, model, path);
+}
+void write_csv(const OcpResult& result, const Pds& model, const std::string& path) {
+  csv_of_ocp(result, model, path);
 }
 
 }  // namespace fesd

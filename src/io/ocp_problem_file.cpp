@@ -24,9 +24,11 @@
 #include <toml++/toml.h>
 
 #include "fesd/error.hpp"
+#include "fesd/pds_problem_file.hpp"
 #include "fesd/problem_file.hpp"
 #include "io/ocp_expression_functions.hpp"
 #include "io/option_target.hpp"
+#include "io/pds_model_reader.hpp"
 #include "io/problem_file_reader.hpp"
 #include "ocp/ocp_input.hpp"
 
@@ -90,7 +92,8 @@ void complete_bounds(Bounds& b, int n, double lb_default, double ub_default) {
 }
 
 /// [discretization] N_finite_elements: one integer for all control intervals, or a list.
-void read_N_FE(const Reader& r, const toml::node& n, OcpProblem& problem) {
+template <class Problem>
+void read_N_FE(const Reader& r, const toml::node& n, Problem& problem) {
   const std::string path = "discretization.N_finite_elements";
   if (n.is_integer()) {
     problem.options.discretization.N_FE = r.integer(n, path);
@@ -109,7 +112,9 @@ void read_N_FE(const Reader& r, const toml::node& n, OcpProblem& problem) {
 /// The options of [ocp], [discretization], [homotopy] and [ipopt], then every input rule of the
 /// OCP (src/ocp/ocp_input.cpp): the problem's data first (ProblemFileError), then the options
 /// (InvalidOption), each message at the line of the key it names.
-void read_options(const Reader& r, const toml::table& root, OcpProblem& problem,
+/// `read_stage_data` runs after the option tables (it needs T and N_stages), before the rules.
+template <class Problem>
+void read_options(const Reader& r, const toml::table& root, Problem& problem,
                   const std::function<void()>& read_stage_data) {
   const registry::OptionTarget target = target_of(problem);
   static constexpr std::array<std::string_view, 1> kPerInterval{"N_finite_elements"};
@@ -122,13 +127,13 @@ void read_options(const Reader& r, const toml::table& root, OcpProblem& problem,
     if (table == registry::Table::Discretization)
       if (const toml::node* n = t.get(kPerInterval[0])) read_N_FE(r, *n, problem);
   }
-  read_stage_data();  // needs T and N_stages
+  read_stage_data();
   const ocp_detail::OcpInputErrors errors = ocp_detail::check_input(problem.ocp, problem.options);
   if (!errors.data.empty()) throw ProblemFileError(located(r, root, errors.data));
   if (!errors.options.empty()) throw_validation_errors(r, root, errors.options);
 }
 
-/// `u_guess`, `x_guess`: a vector, or (rows) an array of `n_rows` vectors of `n` numbers.
+/// `u_guess`, `x_guess`: an array of `n_rows` vectors of `length` numbers.
 std::vector<Eigen::VectorXd> read_rows(const Reader& r, const toml::node& n, std::string_view path,
                                        int n_rows, std::string_view rows_what, int length,
                                        std::string_view what) {
@@ -141,6 +146,51 @@ std::vector<Eigen::VectorXd> read_rows(const Reader& r, const toml::node& n, std
   return rows;
 }
 
+Eigen::VectorXd append(const Eigen::VectorXd& v, double value);
+
+/// The guesses and parameters per control interval of [ocp] (once T and N_stages are known):
+/// u_guess (one vector, or one row per interval), x_guess (the states at the control grid points;
+/// a clock state gets t_k; it makes initialization = external unless the file sets it) and
+/// p_time_var ({name = [one value per interval]}, names of [model] p).
+void read_stage_data(const Reader& r, const toml::table& t, const std::vector<std::string>& p_names,
+                     int n_x_user, int n_u, bool has_clock, OcpData& ocp, OcpOptions& options) {
+  const std::string per_state = "one per state in model.x";
+  const std::string per_control = "one per control in model.u";
+  if (const toml::node* n = t.get("u_guess")) {
+    const toml::array* a = n->as_array();
+    if (a != nullptr && !a->empty() && (*a)[0].is_array())  // one row per control interval
+      ocp.u_guess_stage = read_rows(r, *n, "ocp.u_guess", ocp.N_stages,
+                                    "one per control interval, N_stages", n_u, per_control);
+    else
+      ocp.u_guess = r.vector(*n, "ocp.u_guess", n_u, per_control);
+  }
+  if (const toml::node* n = t.get("x_guess")) {
+    ocp.x_guess = read_rows(r, *n, "ocp.x_guess", ocp.N_stages + 1,
+                            "one per control grid point t_k = k T / N_stages, k = 0..N_stages",
+                            n_x_user, per_state);
+    if (has_clock)
+      for (std::size_t k = 0; k < ocp.x_guess.size(); ++k)
+        ocp.x_guess[k] = append(ocp.x_guess[k], static_cast<double>(k) * ocp.T / ocp.N_stages);
+    if (t.get("initialization") == nullptr) options.initialization = OcpInitialization::External;
+  }
+  if (const toml::node* n = t.get("p_time_var")) {
+    const toml::table& pt = r.table(*n, "ocp.p_time_var");
+    ocp.p_stage.assign(static_cast<std::size_t>(ocp.N_stages), ocp.p);
+    for (const auto& [key, value] : pt) {
+      const std::string name(key.str());
+      const std::string path = "ocp.p_time_var." + name;
+      const auto it = std::find(p_names.begin(), p_names.end(), name);
+      if (it == p_names.end())
+        r.fail(value.source(), path,
+               fmt::format("unknown parameter '{}' (expected a name of [model] p)", name));
+      const Eigen::VectorXd v =
+          r.vector(value, path, ocp.N_stages, "one value per control interval, N_stages");
+      const auto i = static_cast<Eigen::Index>(it - p_names.begin());
+      for (int k = 0; k < ocp.N_stages; ++k) ocp.p_stage[static_cast<std::size_t>(k)][i] = v[k];
+    }
+  }
+}
+
 /// v with `value` appended (the clock's entry).
 Eigen::VectorXd append(const Eigen::VectorXd& v, double value) {
   Eigen::VectorXd out(v.size() + 1);
@@ -148,40 +198,9 @@ Eigen::VectorXd append(const Eigen::VectorXd& v, double value) {
   return out;
 }
 
-}  // namespace
-
-OcpProblem parse_ocp_problem(std::string_view toml_text, std::string_view source_name) {
-  const Reader r{std::string(source_name)};
-  const toml::table root = parse_toml(toml_text, source_name);
-  const toml::node* ocp_node = root.get("ocp");
-  if (const toml::node* sim = root.get("simulation"))
-    r.fail(sim->source(), "simulation",
-           ocp_node != nullptr
-               ? "both [simulation] and [ocp] given (expected exactly one: [simulation] for a "
-                 "simulation, [ocp] for an optimal control problem)"
-               : "this is a simulation file (a [simulation] table, expected [ocp]): run it with "
-                 "`fesd simulate` or fesd::load_simulation_problem");
-  r.check_keys(root, kTopKeys, "");
-  if (ocp_node == nullptr)
-    r.fail(toml::source_region{}, "ocp",
-           "missing table [ocp] (expected at least T, the length of the horizon)");
-
-  OcpProblem problem;
-  read_name(r, root, source_name, problem);
-
-  ModelSpec spec = read_model_spec(r, root);
-  const Symbols sym = spec.sym;
-  const int n_x_user = static_cast<int>(sym.x.size());
-  const int n_u = static_cast<int>(sym.u.size());
-
-  // [ocp]: keys, then the expressions (they may read t, which decides the clock).
-  const toml::table& t = r.table(*ocp_node, "ocp");
-  if (const toml::node* x0 = t.get("x0"))
-    r.fail(x0->source(), "ocp.x0",
-           "x0 belongs in [model] (the initial state; with lbx0/ubx0 in [ocp] it is the guess of "
-           "a free initial state)");
-  check_table_keys(r, t, registry::Table::Ocp, kKind);
-  check_required_key(r, t, registry::Table::Ocp);
+/// The expressions of [ocp]: f_q, f_q_T, g_path, g_terminal (f_q_T and g_terminal without
+/// controls).
+OcpExpressions read_ocp_expressions(const Reader& r, const toml::table& t, const Symbols& sym) {
   OcpExpressions e;
   if (const toml::node* n = t.get("f_q")) e.f_q = r.expression(*n, "ocp.f_q", sym.all);
   if (const toml::node* n = t.get("f_q_T")) {
@@ -196,34 +215,15 @@ OcpProblem parse_ocp_problem(std::string_view toml_text, std::string_view source
     e.g_terminal = read_expressions(r, *g_terminal, "ocp.g_terminal", sym, false,
                                     "a terminal constraint g_terminal(x, p)");
 
-  const auto reads_time = [&](const expr::Expression& x) {
-    return sym.time_index >= 0 && x.depends_on(sym.time_index);
-  };
-  bool has_clock = spec.uses_time();
-  if (e.f_q) has_clock = has_clock || reads_time(*e.f_q);
-  if (e.f_q_T) has_clock = has_clock || reads_time(*e.f_q_T);
-  for (const auto* list : {&e.g_path, &e.g_terminal})
-    has_clock = has_clock || std::any_of(list->begin(), list->end(), reads_time);
+  return e;
+}
 
-  // [model] x0 and the Pss; the OCP starts at t = 0.
-  BuiltModel built = build_model(r, std::move(spec), has_clock, 0.0);
-  Ocp& ocp = problem.ocp;
-  ocp.model = std::move(built.model);
-  ocp.x0 = std::move(built.x0);
-  ocp.p = std::move(built.p);
-  problem.has_clock = has_clock;
-  ExpressionLayout layout;
-  layout.n_x = ocp.model.n_x();
-  layout.n_x_slots = n_x_user + (sym.time_index >= 0 ? 1 : 0);
-  layout.n_u = n_u;
-  layout.n_p = ocp.model.n_p();
-  ocp.n_g_path = static_cast<int>(e.g_path.size());
-  ocp.n_g_terminal = static_cast<int>(e.g_terminal.size());
-  // Its layout checks are invariants of this reader (fesd::InternalError), not input errors.
-  ocp.functions = std::make_shared<const ExpressionOcpFunctions>(layout, std::move(e));
-
-  // Bounds and guesses; their rules (lb <= ub, guesses within bounds) are checked with the
-  // options (read_options). The clock (if any) is unbounded and starts at 0.
+/// The bounds and guesses of [ocp] into `ocp` (n_x_user states in the file, a clock state
+/// appended if has_clock; n_u controls; the constraint counts already set). Their rules (lb <= ub,
+/// guesses within bounds) are checked with the options (read_options).
+void read_ocp_bounds(const Reader& r, const toml::table& t, int n_x_user, int n_u, bool has_clock,
+                     OcpData& ocp) {
+  // The clock (if any) is unbounded and starts at 0.
   const std::string per_state = "one per state in model.x";
   const std::string per_control = "one per control in model.u";
   Bounds x = read_bounds(r, t, "lbx", "ubx", n_x_user, per_state);
@@ -256,50 +256,148 @@ OcpProblem parse_ocp_problem(std::string_view toml_text, std::string_view source
   complete_bounds(gt, ocp.n_g_terminal, 0.0, 0.0);
   ocp.lbg_terminal = gt.lb;
   ocp.ubg_terminal = gt.ub;
+}
 
-  // Guesses and parameters per control interval: read once T and N_stages are known.
-  const auto read_stage_data = [&] {
-    if (const toml::node* n = t.get("u_guess")) {
-      const toml::array* a = n->as_array();
-      if (a != nullptr && !a->empty() && (*a)[0].is_array())  // one row per control interval
-        ocp.u_guess_stage = read_rows(r, *n, "ocp.u_guess", ocp.N_stages,
-                                      "one per control interval, N_stages", n_u, per_control);
-      else
-        ocp.u_guess = r.vector(*n, "ocp.u_guess", n_u, per_control);
-    }
-    if (const toml::node* n = t.get("x_guess")) {
-      // The states at t_k = k T / N_stages; the clock's guess is t_k itself.
-      ocp.x_guess = read_rows(r, *n, "ocp.x_guess", ocp.N_stages + 1,
-                              "one per control grid point t_k = k T / N_stages, k = 0..N_stages",
-                              n_x_user, per_state);
-      if (has_clock)
-        for (std::size_t k = 0; k < ocp.x_guess.size(); ++k)
-          ocp.x_guess[k] = append(ocp.x_guess[k], static_cast<double>(k) * ocp.T / ocp.N_stages);
-      // A guess of the states means initialization = external unless the file says otherwise.
-      if (t.get("initialization") == nullptr)
-        problem.options.initialization = OcpInitialization::External;
-    }
-    if (const toml::node* n = t.get("p_time_var")) {
-      // {name = [one value per control interval]}: those parameters per interval, the others as
-      // in [model] p.
-      const toml::table& pt = r.table(*n, "ocp.p_time_var");
-      ocp.p_stage.assign(static_cast<std::size_t>(ocp.N_stages), ocp.p);
-      for (const auto& [key, value] : pt) {
-        const std::string name(key.str());
-        const std::string path = "ocp.p_time_var." + name;
-        const auto it = std::find(sym.p.begin(), sym.p.end(), name);
-        if (it == sym.p.end())
-          r.fail(value.source(), path,
-                 fmt::format("unknown parameter '{}' (expected a name of [model] p)", name));
-        const Eigen::VectorXd v =
-            r.vector(value, path, ocp.N_stages, "one value per control interval, N_stages");
-        const auto i = static_cast<Eigen::Index>(it - sym.p.begin());
-        for (int k = 0; k < ocp.N_stages; ++k) ocp.p_stage[static_cast<std::size_t>(k)][i] = v[k];
-      }
-    }
+}  // namespace
+
+OcpProblem parse_ocp_problem(std::string_view toml_text, std::string_view source_name) {
+  const Reader r{std::string(source_name)};
+  const toml::table root = parse_toml(toml_text, source_name);
+  const toml::node* ocp_node = root.get("ocp");
+  if (const toml::node* sim = root.get("simulation"))
+    r.fail(sim->source(), "simulation",
+           ocp_node != nullptr
+               ? "both [simulation] and [ocp] given (expected exactly one: [simulation] for a "
+                 "simulation, [ocp] for an optimal control problem)"
+               : "this is a simulation file (a [simulation] table, expected [ocp]): run it with "
+                 "`fesd simulate` or fesd::load_simulation_problem");
+  r.check_keys(root, kTopKeys, "");
+  if (ocp_node == nullptr)
+    r.fail(toml::source_region{}, "ocp",
+           "missing table [ocp] (expected at least T, the length of the horizon)");
+  if (const toml::node* m = root.get("model"); m != nullptr && m->as_table() != nullptr)
+    if (const toml::node* kind = m->as_table()->get("kind"))
+      r.fail(kind->source(), "model.kind",
+             "a projected model: read the file with fesd::load_pds_ocp_problem (`fesd solve` "
+             "does)");
+
+  OcpProblem problem;
+  read_name(r, root, source_name, problem);
+
+  ModelSpec spec = read_model_spec(r, root);
+  const Symbols sym = spec.sym;
+  const int n_x_user = static_cast<int>(sym.x.size());
+  const int n_u = static_cast<int>(sym.u.size());
+
+  // [ocp]: keys, then the expressions (they may read t, which decides the clock).
+  const toml::table& t = r.table(*ocp_node, "ocp");
+  if (const toml::node* x0 = t.get("x0"))
+    r.fail(x0->source(), "ocp.x0",
+           "x0 belongs in [model] (the initial state; with lbx0/ubx0 in [ocp] it is the guess of "
+           "a free initial state)");
+  check_table_keys(r, t, registry::Table::Ocp, kKind);
+  check_required_key(r, t, registry::Table::Ocp);
+  OcpExpressions e = read_ocp_expressions(r, t, sym);
+  const auto reads_time = [&](const expr::Expression& x) {
+    return sym.time_index >= 0 && x.depends_on(sym.time_index);
   };
-  read_options(r, root, problem, read_stage_data);
+  bool has_clock = spec.uses_time();
+  if (e.f_q) has_clock = has_clock || reads_time(*e.f_q);
+  if (e.f_q_T) has_clock = has_clock || reads_time(*e.f_q_T);
+  for (const auto* list : {&e.g_path, &e.g_terminal})
+    has_clock = has_clock || std::any_of(list->begin(), list->end(), reads_time);
+
+  // [model] x0 and the Pss; the OCP starts at t = 0.
+  BuiltModel built = build_model(r, std::move(spec), has_clock, 0.0);
+  Ocp& ocp = problem.ocp;
+  ocp.model = std::move(built.model);
+  ocp.x0 = std::move(built.x0);
+  ocp.p = std::move(built.p);
+  problem.has_clock = has_clock;
+  ExpressionLayout layout;
+  layout.n_x = ocp.model.n_x();
+  layout.n_x_slots = n_x_user + (sym.time_index >= 0 ? 1 : 0);
+  layout.n_u = n_u;
+  layout.n_p = ocp.model.n_p();
+  ocp.n_g_path = static_cast<int>(e.g_path.size());
+  ocp.n_g_terminal = static_cast<int>(e.g_terminal.size());
+  // Its layout checks are invariants of this reader (fesd::InternalError), not input errors.
+  ocp.functions = std::make_shared<const ExpressionOcpFunctions>(layout, std::move(e));
+
+  read_ocp_bounds(r, t, n_x_user, n_u, has_clock, ocp);
+  read_options(r, root, problem, [&] {
+    read_stage_data(r, t, sym.p, n_x_user, n_u, has_clock, ocp, problem.options);
+  });
   return problem;
+}
+
+PdsOcpProblem parse_pds_ocp_problem(std::string_view toml_text, std::string_view source_name) {
+  const Reader r{std::string(source_name)};
+  const toml::table root = parse_toml(toml_text, source_name);
+  const toml::node* ocp_node = root.get("ocp");
+  if (const toml::node* sim = root.get("simulation"))
+    r.fail(sim->source(), "simulation",
+           "a [simulation] table in an optimal control problem file (expected [ocp]; a "
+           "simulation file is run with `fesd simulate`)");
+  r.check_keys(root, kTopKeys, "");
+  if (ocp_node == nullptr)
+    r.fail(toml::source_region{}, "ocp",
+           "missing table [ocp] (expected at least T, the length of the horizon)");
+  PdsOcpProblem problem;
+  read_name(r, root, source_name, problem);
+  PdsModelRead m = read_pds_model(r, root);
+  const toml::table& t = r.table(*ocp_node, "ocp");
+  if (const toml::node* x0 = t.get("x0"))
+    r.fail(x0->source(), "ocp.x0", "x0 belongs in [model] (the initial state)");
+  check_table_keys(r, t, registry::Table::Ocp, kKind);
+  check_required_key(r, t, registry::Table::Ocp);
+  OcpExpressions e = read_ocp_expressions(r, t, m.sym);
+  const auto reads_time = [&](const expr::Expression& x) { return x.depends_on(m.sym.time_index); };
+  bool uses_time = (e.f_q && reads_time(*e.f_q)) || (e.f_q_T && reads_time(*e.f_q_T));
+  for (const auto* list : {&e.g_path, &e.g_terminal})
+    uses_time = uses_time || std::any_of(list->begin(), list->end(), reads_time);
+  if (uses_time)
+    r.fail(ocp_node->source(), "ocp",
+           "an expression uses the time t, which projected models do not support yet");
+  PdsOcp& ocp = problem.ocp;
+  ocp.model = std::move(m.model);
+  ocp.x0 = std::move(m.x0);
+  ocp.p = std::move(m.p);
+  const int n_x = ocp.model.n_x(), n_u = ocp.model.n_u();
+  const ExpressionLayout layout{
+      .n_x = n_x, .n_x_slots = n_x + 1, .n_u = n_u, .n_p = ocp.model.n_p()};
+  ocp.n_g_path = static_cast<int>(e.g_path.size());
+  ocp.n_g_terminal = static_cast<int>(e.g_terminal.size());
+  ocp.functions = std::make_shared<const ExpressionOcpFunctions>(layout, std::move(e));
+  read_ocp_bounds(r, t, n_x, n_u, /*has_clock=*/false, ocp);
+  read_options(r, root, problem, [&] {
+    read_stage_data(r, t, m.sym.p, n_x, n_u, /*has_clock=*/false, ocp, problem.options);
+  });
+  return problem;
+}
+
+void apply_override(PdsOcpProblem& problem, std::string_view key, std::string_view value) {
+  const OverrideArg arg = parse_override_arg(key, value, kKind);
+  PdsOcpProblem updated = problem;
+  if (set_scalar_override(arg, target_of(updated))) {
+    // One number for every control interval replaces a per-interval list.
+    if (arg.option->key == "N_finite_elements") updated.ocp.N_FE.clear();
+  } else if (arg.option != nullptr && arg.option->key == "u_guess") {
+    updated.ocp.u_guess = override_vector(arg.head, arg.value, updated.ocp.model.n_u(),
+                                          "ocp.u_guess", "one per control in model.u");
+    updated.ocp.u_guess_stage.clear();  // one guess for every interval now
+  } else if (!set_pds_override(arg, updated.ocp.model.n_x(), updated.ocp.model.n_u(),
+                               updated.options.nlp.extra, updated.ocp.x0, nullptr)) {
+    unknown_override(arg, kKind, Pss{});
+  }
+  ocp_detail::OcpInputErrors errors = ocp_detail::check_input(updated.ocp, updated.options);
+  for (std::string& e : errors.data) errors.options.push_back(std::move(e));
+  if (!errors.options.empty()) throw_override_errors(arg, errors.options);
+  problem = std::move(updated);
+}
+
+PdsOcpProblem load_pds_ocp_problem(const std::string& path) {
+  return parse_pds_ocp_problem(read_problem_text(path), path);
 }
 
 OcpProblem load_ocp_problem(const std::string& path) {

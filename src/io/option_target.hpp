@@ -2,6 +2,7 @@
 // (src/core/option_registry.hpp). Light: no TOML, for the loaders and the tests.
 #pragma once
 #include "core/option_registry.hpp"
+#include "fesd/pds_problem_file.hpp"
 #include "fesd/problem_file.hpp"
 
 namespace fesd::io_detail {
@@ -13,6 +14,12 @@ inline registry::OptionTarget target_of(SimulationProblem& q) {
   t.tol_sim = &q.tol_sim;
   t.N_sim_max = &q.N_sim_max;
   t.error_estimate = &q.error_estimate;
+  return t;
+}
+
+inline registry::OptionTarget target_of(PdsOcpProblem& q) {
+  registry::OptionTarget t = registry::target_of(q.options);
+  t.ocp = &q.ocp;
   return t;
 }
 

@@ -14,6 +14,7 @@
 #include "fesd/error.hpp"
 #include "fesd/problem_file.hpp"
 #include "io/option_target.hpp"
+#include "io/pds_model_reader.hpp"
 #include "io/problem_file_reader.hpp"
 #include "model/expression_pds.hpp"
 
@@ -37,26 +38,10 @@ const toml::table* model_table(const toml::table& root) {
 
 }  // namespace
 
-bool is_projected_problem_file(const std::string& path) {
-  const toml::table root = parse_toml(read_problem_text(path), path);
-  const toml::table* m = model_table(root);
-  if (m == nullptr) return false;
-  const toml::node* kind = m->get("kind");
-  return kind != nullptr && kind->as_string() != nullptr && kind->as_string()->get() == "projected";
-}
+namespace io_detail {
 
-PdsSimulationProblem parse_pds_simulation_problem(std::string_view toml_text,
-                                                  std::string_view source_name) {
-  const Reader r{std::string(source_name)};
-  const toml::table root = parse_toml(toml_text, source_name);
-  if (const toml::node* ocp = root.get("ocp"))
-    r.fail(ocp->source(), "ocp",
-           "optimal control of projected systems is not supported yet (expected [simulation])");
-  r.check_keys(root, kTopKeys, "");
-  PdsSimulationProblem problem;
-  read_name(r, root, source_name, problem);
-
-  // ---- [model] ----
+PdsModelRead read_pds_model(const Reader& r, const toml::table& root) {
+  PdsModelRead model_read;
   const toml::node* model_node = root.get("model");
   if (model_node == nullptr)
     r.fail(toml::source_region{}, "model",
@@ -136,30 +121,66 @@ PdsSimulationProblem parse_pds_simulation_problem(std::string_view toml_text,
   std::vector<expr::Expression> c =
       expressions(required("constraints", "the constraints c(x) >= 0 that define C"),
                   "model.constraints", -1, "at least one constraint c(x) >= 0");
-  problem.x0 = r.vector(required("x0", "the initial state"), "model.x0", n_x, "one per state in x");
+  model_read.x0 =
+      r.vector(required("x0", "the initial state"), "model.x0", n_x, "one per state in x");
   ExpressionLayout layout{.n_x = n_x,
                           .n_x_slots = n_x + 1,
                           .n_u = static_cast<int>(u_names.size()),
                           .n_p = static_cast<int>(p_names.size())};
   const int n_c = static_cast<int>(c.size());  // (c is moved in the call below)
   try {
-    problem.model =
+    model_read.model =
         make_expression_pds(PdsDims{.n_x = n_x, .n_u = layout.n_u, .n_p = layout.n_p, .n_c = n_c},
                             layout, std::move(f), std::move(c));
   } catch (const InvalidModel& e) {
     throw InvalidModel(fmt::format("{}: {}", r.at(model.source()), e.what()));
   }
-  problem.model.state_names = x_names;
-  problem.model.control_names = u_names;
-  problem.model.parameter_names = p_names;
-  problem.p = Eigen::Map<const Eigen::VectorXd>(p_values.data(),
-                                                static_cast<Eigen::Index>(p_values.size()));
-  problem.model.p_default = problem.p;
+  model_read.model.state_names = x_names;
+  model_read.model.control_names = u_names;
+  model_read.model.parameter_names = p_names;
+  model_read.p = Eigen::Map<const Eigen::VectorXd>(p_values.data(),
+                                                   static_cast<Eigen::Index>(p_values.size()));
+  model_read.model.p_default = model_read.p;
   if (const toml::node* n = model.get("x0_tol")) {
-    problem.model.x0_tol = r.number(*n, "model.x0_tol");
-    if (problem.model.x0_tol < 0) r.fail(n->source(), "model.x0_tol", "must be >= 0");
+    model_read.model.x0_tol = r.number(*n, "model.x0_tol");
+    if (model_read.model.x0_tol < 0) r.fail(n->source(), "model.x0_tol", "must be >= 0");
   }
-  problem.u = Eigen::VectorXd::Zero(layout.n_u);
+  model_read.sym.x = x_names;
+  model_read.sym.u = u_names;
+  model_read.sym.p = p_names;
+  model_read.sym.all = symbols;
+  model_read.sym.time_index = time_slot;
+  return model_read;
+}
+
+}  // namespace io_detail
+
+bool is_projected_problem_file(const std::string& path) {
+  const toml::table root = parse_toml(read_problem_text(path), path);
+  const toml::table* m = model_table(root);
+  if (m == nullptr) return false;
+  const toml::node* kind = m->get("kind");
+  return kind != nullptr && kind->as_string() != nullptr && kind->as_string()->get() == "projected";
+}
+
+PdsSimulationProblem parse_pds_simulation_problem(std::string_view toml_text,
+                                                  std::string_view source_name) {
+  const Reader r{std::string(source_name)};
+  const toml::table root = parse_toml(toml_text, source_name);
+  if (const toml::node* ocp = root.get("ocp"))
+    r.fail(ocp->source(), "ocp",
+           "this is an optimal control problem file (an [ocp] table, expected [simulation]): run "
+           "it with `fesd solve` or fesd::load_pds_ocp_problem");
+  r.check_keys(root, kTopKeys, "");
+  PdsSimulationProblem problem;
+  read_name(r, root, source_name, problem);
+
+  PdsModelRead m = read_pds_model(r, root);
+  problem.model = std::move(m.model);
+  problem.x0 = std::move(m.x0);
+  problem.p = std::move(m.p);
+  const int n_u = problem.model.n_u();
+  problem.u = Eigen::VectorXd::Zero(n_u);
 
   // ---- [simulation] and the option tables (the keys of simulation files) ----
   SimulationProblem options_only;  // the registry writes into its fields
@@ -173,7 +194,7 @@ PdsSimulationProblem parse_pds_simulation_problem(std::string_view toml_text,
     const toml::table& t = r.table(*tn, registry::to_string(table));
     if (table == registry::Table::Simulation) {
       if (const toml::node* un = t.get("u"))
-        problem.u = r.vector(*un, "simulation.u", layout.n_u, "one per control in model.u");
+        problem.u = r.vector(*un, "simulation.u", n_u, "one per control in model.u");
       if (const toml::node* tol = t.get("tol_sim"))
         r.fail(tol->source(), "simulation.tol_sim",
                "not supported for projected models yet (give N_sim)");
@@ -202,6 +223,52 @@ PdsSimulationProblem load_pds_simulation_problem(const std::string& path) {
 
 IntegratorResult simulate(const PdsSimulationProblem& q) {
   return integrate(q.model, q.x0, q.T_sim, q.N_sim, q.options, q.u, q.p, q.pds);
+}
+
+namespace io_detail {
+
+bool set_pds_override(const OverrideArg& a, int n_x, int n_u,
+                      std::vector<std::pair<std::string, std::string>>& ipopt_extra,
+                      Eigen::VectorXd& x0, Eigen::VectorXd* u) {
+  const std::string_view key = a.option != nullptr ? a.option->key : a.key;
+  if (a.table == "ipopt" && !a.key.empty()) {
+    set_ipopt_option(ipopt_extra, a.key, a.value);
+  } else if ((a.table.empty() || a.table == "model") && a.key == "x0") {
+    x0 = override_vector(a.head, a.value, n_x, "model.x0", "one per state");
+  } else if (u != nullptr && key == "u") {
+    *u = override_vector(a.head, a.value, n_u, "simulation.u", "one per control");
+  } else if (key == "tol_sim" || key == "t0" || (a.table.empty() && a.key == "p")) {
+    throw InvalidOption(fmt::format("{}: not supported for projected models yet", a.head));
+  } else {
+    return false;
+  }
+  return true;
+}
+
+}  // namespace io_detail
+
+void apply_override(PdsSimulationProblem& problem, std::string_view key, std::string_view value) {
+  const OverrideArg arg = parse_override_arg(key, value, kKind);
+  // The registry writes into the fields of a SimulationProblem (as when reading the file).
+  SimulationProblem s;
+  s.options = problem.options;
+  s.T_sim = problem.T_sim;
+  s.N_sim = problem.N_sim;
+  PdsSimulationProblem updated = problem;
+  if (!set_scalar_override(arg, target_of(s)) &&
+      !set_pds_override(arg, updated.model.n_x(), updated.model.n_u(), s.options.nlp.extra,
+                        updated.x0, &updated.u))
+    unknown_override(arg, kKind, Pss{});
+  if (s.tol_sim > 0)
+    override_error(arg.head, "not supported for projected models yet (give N_sim)");
+  updated.options = s.options;
+  updated.T_sim = s.T_sim;
+  updated.N_sim = s.N_sim;
+  std::vector<std::string> errors = registry::validate_simulation(updated.T_sim, updated.N_sim);
+  for (std::string& e : validate(updated.options)) errors.push_back(std::move(e));
+  if (updated.N_sim < 1) errors.push_back("simulation.N_sim: must be >= 1 for projected models");
+  if (!errors.empty()) throw_override_errors(arg, errors);
+  problem = std::move(updated);
 }
 
 }  // namespace fesd

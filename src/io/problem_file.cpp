@@ -22,6 +22,7 @@
 #include "core/limits.hpp"
 #include "discretization/fesd_interval.hpp"
 #include "fesd/error.hpp"
+#include "fesd/pds_problem_file.hpp"
 #include "fesd/problem_file.hpp"
 #include "io/option_target.hpp"
 #include "io/problem_file_reader.hpp"
@@ -175,6 +176,14 @@ void apply_overrides(SimulationProblem& problem, const OverrideList& overrides) 
 }
 
 void apply_overrides(OcpProblem& problem, const OverrideList& overrides) {
+  apply_all(problem, overrides);
+}
+
+void apply_overrides(PdsSimulationProblem& problem, const OverrideList& overrides) {
+  apply_all(problem, overrides);
+}
+
+void apply_overrides(PdsOcpProblem& problem, const OverrideList& overrides) {
   apply_all(problem, overrides);
 }
 

@@ -28,6 +28,7 @@
 #include "ocp/allocation.hpp"
 #include "ocp/ocp_checks.hpp"
 #include "ocp/ocp_input.hpp"
+#include "ocp/ocp_terms.hpp"
 
 namespace fesd {
 namespace {
@@ -39,102 +40,12 @@ using Clock = std::chrono::steady_clock;
 using discretization::FesdInterval;
 using discretization::IntervalInputs;
 using nlp::kInf;
-
-/// The parameter values of every control interval (Ocp::p_stage, or p in each).
-using StageParameters = std::vector<Eigen::VectorXd>;
-
-StageParameters stage_parameters(const Ocp& ocp) {
-  if (!ocp.p_stage.empty()) return ocp.p_stage;
-  return StageParameters(static_cast<std::size_t>(ocp.N_stages),
-                         ocp.p.size() > 0 ? ocp.p : ocp.model.p_default);
-}
-
-/// The control guess of interval k (Ocp::u_guess_stage, u_guess, or 0).
-Eigen::VectorXd control_guess(const Ocp& ocp, int k) {
-  if (!ocp.u_guess_stage.empty()) return ocp.u_guess_stage[static_cast<std::size_t>(k)];
-  return ocp.u_guess.size() > 0 ? ocp.u_guess : Eigen::VectorXd::Zero(ocp.model.n_u());
-}
-
-std::vector<int> range(int first, int n) {
-  std::vector<int> r(n);
-  for (int i = 0; i < n; ++i) r[i] = first + i;
-  return r;
-}
-
-// ---- cost and constraint blocks ----------------------------------------------------------------
-
-/// h * sum_j b_j f_q(X_j, q, p): the Lagrange term of one element with the RK quadrature.
-/// inputs: h, X_1 .. X_{n_s} (n_x each), q (n_u), p (n_p)
-struct LagrangeTerm {
-  const OcpFunctions* f;
-  std::vector<double> b;
-  int n_x, n_u, n_p;
-  int num_inputs() const { return 1 + static_cast<int>(b.size()) * n_x + n_u + n_p; }
-  int num_outputs() const { return 1; }
-  template <class T>
-  void operator()(const T* w, T* c) const {
-    const int n_s = static_cast<int>(b.size());
-    const T* q = w + 1 + n_s * n_x;
-    const T* p = q + n_u;
-    T s(0.0);
-    for (int j = 0; j < n_s; ++j) s = s + b[j] * f->f_q(w + 1 + j * n_x, q, p);
-    c[0] = w[0] * s;
-  }
-};
-
-/// f_q_T(x, p).  inputs: x (n_x), p (n_p)
-struct MayerTerm {
-  const OcpFunctions* f;
-  int n_x, n_p;
-  int num_inputs() const { return n_x + n_p; }
-  int num_outputs() const { return 1; }
-  template <class T>
-  void operator()(const T* w, T* c) const {
-    c[0] = f->f_q_T(w, w + n_x);
-  }
-};
-
-/// g_path(x, q, p).  inputs: x (n_x), q (n_u), p (n_p)
-struct PathConstraint {
-  const OcpFunctions* f;
-  int n_x, n_u, n_p, n_g;
-  int num_inputs() const { return n_x + n_u + n_p; }
-  int num_outputs() const { return n_g; }
-  template <class T>
-  void operator()(const T* w, T* c) const {
-    f->g_path(w, w + n_x, w + n_x + n_u, c);
-  }
-};
-
-/// g_terminal(x, p) (soft = false), or with slacks s (soft = true): outputs g - s (<= ub) and
-/// g + s (>= lb).  inputs: x (n_x), p (n_p)[, s (n_g)]
-struct TerminalConstraintEq {
-  const OcpFunctions* f;
-  int n_x, n_p, n_g;
-  bool soft = false;
-  int num_inputs() const { return n_x + n_p + (soft ? n_g : 0); }
-  int num_outputs() const { return soft ? 2 * n_g : n_g; }
-  template <class T>
-  void operator()(const T* w, T* c) const {
-    f->g_terminal(w, w + n_x, c);
-    if (!soft) return;
-    const T* s = w + n_x + n_p;
-    for (int i = 0; i < n_g; ++i) {
-      c[n_g + i] = c[i] + s[i];
-      c[i] = c[i] - s[i];
-    }
-  }
-};
-
-// ---- bounds (empty: unbounded)-------------------------------------------------------------------
-// --------------------------------------------------------------------
-
-double lower(const Eigen::VectorXd& lb, Eigen::Index i) {
-  return lb.size() == 0 ? -kInf : std::max(lb[i], -kInf);
-}
-double upper(const Eigen::VectorXd& ub, Eigen::Index i) {
-  return ub.size() == 0 ? kInf : std::min(ub[i], kInf);
-}
+using ocp_detail::control_guess;
+using ocp_detail::LagrangeTerm;
+using ocp_detail::MayerTerm;
+using ocp_detail::range;
+using ocp_detail::StageParameters;
+using ocp_detail::TerminalConstraintEq;
 
 std::vector<int> intervals_N_FE(const Ocp& ocp, const OcpOptions& o) {
   if (ocp.N_FE.empty()) return std::vector<int>(ocp.N_stages, o.discretization.N_FE);
@@ -144,44 +55,20 @@ std::vector<int> intervals_N_FE(const Ocp& ocp, const OcpOptions& o) {
 // ---- the NLP -----------------------------------------------------------------------------------
 
 /// The MPCC of the OCP (59)-(60) and where its pieces live.
-struct OcpNlp {
-  mpcc::Problem mpcc;
-  Tableau tab;
-  std::vector<int> s0, p;
-  std::vector<std::vector<int>> p_k;  // per interval: p, or its own fixed values (p_stage)
-  std::vector<std::vector<int>> q;    // per interval
-  std::vector<std::unique_ptr<FesdInterval>> iv;
+struct OcpNlp : ocp_detail::OcpNlpParts<FesdInterval> {
   std::vector<IntervalInputs> in;
-  std::vector<int> terminal_slacks;
 };
 
 std::unique_ptr<OcpNlp> build(const Ocp& ocp, const OcpOptions& o, const StageParameters& p) {
   const Pss& m = ocp.model;
   const DiscretizationOptions& d = o.discretization;
-  const int n_x = m.n_x(), n_u = m.n_u(), n_p = m.n_p(), n_th = m.n_theta(), n_sys = m.n_sys();
+  const int n_x = m.n_x(), n_u = m.n_u(), n_th = m.n_theta(), n_sys = m.n_sys();
   auto b = std::make_unique<OcpNlp>();
   b->tab = make_tableau(d.rk_scheme, d.n_s);
   mpcc::Problem& mp = b->mpcc;
   nlp::BlockNlp& nlp = mp.nlp();
-  const bool x0_free = ocp.lbx0.size() > 0;
 
-  // s0: fixed to x0, or free within [lbx0, ubx0] intersected with [lbx, ubx].
-  b->s0 = range(nlp.add_variables(n_x, 0.0, 0.0, 0.0), n_x);
-  mp.fix(b->s0, ocp.x0);
-  if (x0_free)
-    for (int i = 0; i < n_x; ++i)
-      mp.bound(b->s0[i], std::max(lower(ocp.lbx0, i), lower(ocp.lbx, i)),
-               std::min(upper(ocp.ubx0, i), upper(ocp.ubx, i)));
-  b->p = range(nlp.add_variables(n_p, 0.0, 0.0, 0.0), n_p);
-  mp.fix(b->p, p.front());
-  for (int k = 0; k < ocp.N_stages; ++k) {
-    if (k == 0 || ocp.p_stage.empty()) {
-      b->p_k.push_back(b->p);
-    } else {
-      b->p_k.push_back(range(nlp.add_variables(n_p, 0.0, 0.0, 0.0), n_p));
-      mp.fix(b->p_k.back(), p[static_cast<std::size_t>(k)]);
-    }
-  }
+  ocp_detail::add_start_and_parameters(mp, ocp, p, b->s0, b->p, b->p_k);
   // The standard method does not use lambda_{0,0}: fixed dummies.
   std::vector<int> dummy_lambda, dummy_mu;
   if (!d.use_fesd) {
@@ -192,16 +79,11 @@ std::unique_ptr<OcpNlp> build(const Ocp& ocp, const OcpOptions& o, const StagePa
   const std::vector<int> N_FE = intervals_N_FE(ocp, o);
   const double T_k = ocp.T / ocp.N_stages;
   for (int k = 0; k < ocp.N_stages; ++k) {
-    std::vector<int> q = range(nlp.add_variables(n_u, 0.0, 0.0, 0.0), n_u);
-    const Eigen::VectorXd u_guess = control_guess(ocp, k);
-    for (int i = 0; i < n_u; ++i) {
-      mp.bound(q[i], lower(ocp.lbu, i), upper(ocp.ubu, i));
-      mp.guess()[q[i]] = std::clamp(u_guess[i], mp.lower(q[i]), mp.upper(q[i]));
-    }
+    std::vector<int> q = ocp_detail::add_control(mp, ocp, n_u, k);
     b->q.push_back(q);
     IntervalInputs in;
     in.q = q;
-    in.p = b->p_k[k];
+    in.p = b->p_k[static_cast<std::size_t>(k)];
     in.T = T_k;
     in.boundary_at_end = true;  // non-stiffly-accurate schemes: lambda at s_{k+1} for the next
     if (k == 0) {
@@ -233,82 +115,8 @@ std::unique_ptr<OcpNlp> build(const Ocp& ocp, const OcpOptions& o, const StagePa
     b->in.push_back(in);
   }
 
-  // ---- state bounds, costs, path constraints per element ----
-  const OcpFunctions* f = ocp.functions.get();
-  std::vector<double> bw;
-  for (int j = 0; j < b->tab.n_s; ++j) bw.push_back(b->tab.b(j));
-  auto lagrange = f && f->has_f_q() ? nlp::make_block(LagrangeTerm{f, bw, n_x, n_u, n_p}) : nullptr;
-  auto path =
-      ocp.n_g_path > 0 ? nlp::make_block(PathConstraint{f, n_x, n_u, n_p, ocp.n_g_path}) : nullptr;
-  std::vector<double> path_lb(ocp.n_g_path), path_ub(ocp.n_g_path);
-  for (int i = 0; i < ocp.n_g_path; ++i) {
-    path_lb[i] = lower(ocp.lbg_path, i);
-    path_ub[i] = upper(ocp.ubg_path, i);
-  }
-  auto bound_state = [&](int first) {
-    for (int i = 0; i < n_x; ++i)
-      mp.bound(first + i, std::max(mp.lower(first + i), lower(ocp.lbx, i)),
-               std::min(mp.upper(first + i), upper(ocp.ubx, i)));
-  };
-  auto add_path = [&](int x_first, const std::vector<int>& q, const std::vector<int>& pk) {
-    if (!path) return;
-    std::vector<int> vars = range(x_first, n_x);
-    vars.insert(vars.end(), q.begin(), q.end());
-    vars.insert(vars.end(), pk.begin(), pk.end());
-    nlp.add_constraint(path, vars, path_lb, path_ub);
-  };
-  add_path(b->s0[0], b->q[0], b->p_k[0]);
-  for (int k = 0; k < ocp.N_stages; ++k) {
-    const FesdInterval& iv = *b->iv[k];
-    for (int n = 0; n < iv.N_FE(); ++n) {
-      bound_state(iv.x(n + 1, 0));
-      add_path(iv.x(n + 1, 0), b->q[k], b->p_k[k]);
-      if (o.constraints_at_stages)
-        for (int s = 0; s < iv.n_s(); ++s) {
-          bound_state(iv.X(n, s, 0));
-          add_path(iv.X(n, s, 0), b->q[k], b->p_k[k]);
-        }
-      if (lagrange) {
-        std::vector<int> vars{iv.h(n)};
-        for (int s = 0; s < iv.n_s(); ++s)
-          for (int i = 0; i < n_x; ++i) vars.push_back(iv.X(n, s, i));
-        vars.insert(vars.end(), b->q[k].begin(), b->q[k].end());
-        vars.insert(vars.end(), b->p_k[k].begin(), b->p_k[k].end());
-        nlp.add_objective(lagrange, vars);
-      }
-    }
-  }
-
-  // ---- terminal cost and constraints at s_N ----
-  const FesdInterval& last = *b->iv.back();
-  std::vector<int> xp = range(last.x(last.N_FE(), 0), n_x);
-  xp.insert(xp.end(), b->p_k.back().begin(), b->p_k.back().end());
-  if (f && f->has_f_q_T()) nlp.add_objective(nlp::make_block(MayerTerm{f, n_x, n_p}), xp);
-  if (ocp.n_g_terminal > 0) {
-    const int n_g = ocp.n_g_terminal;
-    std::vector<double> lb(n_g), ub(n_g);
-    for (int i = 0; i < n_g; ++i) {
-      lb[i] = lower(ocp.lbg_terminal, i);
-      ub[i] = upper(ocp.ubg_terminal, i);
-    }
-    if (ocp.terminal_constraint == TerminalConstraint::Hard) {
-      nlp.add_constraint(nlp::make_block(TerminalConstraintEq{f, n_x, n_p, n_g, false}), xp, lb,
-                         ub);
-    } else {  // l1: g - s <= ub, g + s >= lb, rho * sum s
-      b->terminal_slacks = range(nlp.add_variables(n_g, 0.0, kInf, 0.0), n_g);
-      std::vector<int> vars = xp;
-      vars.insert(vars.end(), b->terminal_slacks.begin(), b->terminal_slacks.end());
-      std::vector<double> lb2(2 * n_g, -kInf), ub2(2 * n_g, kInf);
-      for (int i = 0; i < n_g; ++i) {
-        ub2[i] = ub[i];
-        lb2[n_g + i] = lb[i];
-      }
-      nlp.add_constraint(nlp::make_block(TerminalConstraintEq{f, n_x, n_p, n_g, true}), vars, lb2,
-                         ub2);
-      nlp.add_objective(nlp::make_block(nlp::Sum{n_g}), b->terminal_slacks, ocp.rho_terminal);
-    }
-  }
-
+  ocp_detail::add_ocp_terms(mp, ocp, o, b->tab, n_x, n_u, b->s0, b->p_k, b->q, b->iv,
+                            b->terminal_slacks);
   for (const auto& iv : b->iv) mp.add_complementarity(iv->groups(), iv->residual_pairs());
   mp.relax(o.homotopy.mpcc_mode);
   return b;
@@ -380,13 +188,14 @@ bool guess_simulation(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Stag
   // control guess and parameters, else interval by interval (each from the previous end).
   IntegratorResult r;
   if (ocp.p_stage.empty() && ocp.u_guess_stage.empty()) {
-    r = integrate(m, ocp.x0, ocp.T, ocp.N_stages, io, control_guess(ocp, 0), p.front());
+    r = integrate(m, ocp.x0, ocp.T, ocp.N_stages, io, control_guess(ocp, 0, m.n_u()), p.front());
   } else {
     r.x = {ocp.x0};
     r.status = Status::Success;
     for (int k = 0; k < ocp.N_stages && r.status == Status::Success; ++k) {
-      const IntegratorResult rk = integrate(m, r.x.back(), ocp.T / ocp.N_stages, 1, io,
-                                            control_guess(ocp, k), p[static_cast<std::size_t>(k)]);
+      const IntegratorResult rk =
+          integrate(m, r.x.back(), ocp.T / ocp.N_stages, 1, io, control_guess(ocp, k, m.n_u()),
+                    p[static_cast<std::size_t>(k)]);
       r.status = rk.status;
       if (rk.status != Status::Success || rk.x.empty()) break;
       r.h.insert(r.h.end(), rk.h.begin(), rk.h.end());
@@ -404,7 +213,7 @@ bool guess_simulation(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Stag
   int e = 0;
   for (std::size_t iv_k = 0; iv_k < b.iv.size(); ++iv_k) {
     const FesdInterval& iv = *b.iv[iv_k];
-    const Eigen::VectorXd u = control_guess(ocp, static_cast<int>(iv_k));
+    const Eigen::VectorXd u = control_guess(ocp, static_cast<int>(iv_k), m.n_u());
     const Eigen::VectorXd& pk = p[iv_k];
     for (int n = 0; n < iv.N_FE(); ++n, ++e) {
       w[iv.h(n)] = std::clamp(r.h[e], b.mpcc.lower(iv.h(n)), b.mpcc.upper(iv.h(n)));
@@ -440,48 +249,14 @@ bool guess_simulation(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Stag
 void extract(const OcpNlp& b, const Ocp& ocp, const std::vector<double>& w,
              const StageParameters& p, OcpResult& res) {
   const Pss& m = ocp.model;
-  const int n_x = m.n_x(), n_th = m.n_theta(), n_u = m.n_u();
-  const double T_k = ocp.T / ocp.N_stages;
-  double t = 0;
-  res.t = {0.0};
-  res.x = {gather(w, b.s0[0], n_x)};
-  double objective = 0;
-  const OcpFunctions* f = ocp.functions.get();
-  for (int k = 0; k < ocp.N_stages; ++k) {
-    const FesdInterval& iv = *b.iv[k];
-    const Eigen::VectorXd q = gather(w, b.q[k].empty() ? 0 : b.q[k][0], n_u);
-    res.u.push_back(q);
-    res.t_ctrl.push_back(k * T_k);
-    const std::vector<double> eta = iv.eta(w.data());
-    for (int n = 0; n < iv.N_FE(); ++n) {
-      const double hn = w[iv.h(n)];
-      const std::vector<int> active = iv.active_set(w.data(), n);
-      double quad = 0;
-      for (int s = 0; s < iv.n_s(); ++s) {
-        res.t_stage.push_back(t + b.tab.c(s) * hn);
-        const Eigen::VectorXd X = gather(w, iv.X(n, s, 0), n_x);
-        res.x_stage.push_back(X);
+  const int n_th = m.n_theta();
+  ocp_detail::extract_result(
+      ocp, b.tab, m.n_x(), m.n_u(), b.s0, b.q, b.iv, b.terminal_slacks, w, p, res,
+      [&](const FesdInterval& iv, int n, int s) {
         res.theta.push_back(gather(w, iv.theta(n, s, 0), n_th));
         res.lambda.push_back(gather(w, iv.lambda(n, s, 0), n_th));
-        if (f && f->has_f_q()) quad += b.tab.b(s) * f->f_q(X.data(), q.data(), p[k].data());
-      }
-      objective += hn * quad;
-      if (!res.active_set.empty() && res.active_set.back() != active)
-        res.switches.push_back(
-            {t, static_cast<int>(res.h.size()) - 1, res.active_set.back(), active});
-      res.active_set.push_back(active);
-      res.h.push_back(hn);
-      res.interval.push_back(k);
-      res.eta.push_back(eta[n]);
-      t += hn;
-      res.t.push_back(t);
-      res.x.push_back(gather(w, iv.x(n + 1, 0), n_x));
-    }
-  }
-  res.t_ctrl.push_back(ocp.T);
-  if (f && f->has_f_q_T()) objective += f->f_q_T(res.x.back().data(), p.back().data());
-  for (int s : b.terminal_slacks) objective += ocp.rho_terminal * w[s];
-  res.objective = objective;
+      },
+      [&](const FesdInterval& iv) { return iv.eta(w.data()); });
 }
 
 /// The OCP's own cost (59a) at the NLP point w.
@@ -797,19 +572,26 @@ std::vector<std::string> block_size_errors(const Ocp& ocp, const OcpOptions& o) 
   if (!ocp.N_FE.empty()) d.N_FE = *std::max_element(ocp.N_FE.begin(), ocp.N_FE.end());
   std::vector<std::string> errors = FesdInterval::block_size_errors(ocp.model, d);
   const Pss& m = ocp.model;
-  const int n_x = m.n_x(), n_u = m.n_u(), n_p = m.n_p(), limit = ad::kMaxInputs;
+  for (std::string& e : cost_block_size_errors(ocp, m.n_x(), m.n_u(), m.n_p(), d.n_s))
+    errors.push_back(std::move(e));
+  return errors;
+}
+
+std::vector<std::string> cost_block_size_errors(const OcpData& ocp, int n_x, int n_u, int n_p,
+                                                int n_s) {
+  std::vector<std::string> errors;
+  const int limit = ad::kMaxInputs;
   const OcpFunctions* f = ocp.functions.get();
-  // The blocks build() adds, with the same functors (their input counts need no function). The
-  // path constraints (n_x + n_u + n_p inputs) are smaller than the dynamics block.
+  // The blocks add_ocp_terms() adds, with the same functors (their input counts need no
+  // function). The path constraints (n_x + n_u + n_p inputs) are smaller than the dynamics block.
   if (f != nullptr && f->has_f_q()) {
-    const int k =
-        LagrangeTerm{f, std::vector<double>(o.discretization.n_s), n_x, n_u, n_p}.num_inputs();
+    const int k = LagrangeTerm{f, std::vector<double>(n_s), n_x, n_u, n_p}.num_inputs();
     if (k > limit)
       errors.push_back(fmt::format(
           "ocp.f_q = Lagrange term: integrated over one element it is one block of 1 + n_s n_x + "
           "n_u + n_p = {} inputs (n_s = {}, n_x = {}); at most {} inputs per block are supported "
           "(use fewer stages n_s or fewer states)",
-          k, o.discretization.n_s, n_x, limit));
+          k, n_s, n_x, limit));
   }
   if (f != nullptr && f->has_f_q_T() && MayerTerm{f, n_x, n_p}.num_inputs() > limit)
     errors.push_back(fmt::format(
@@ -829,7 +611,7 @@ std::vector<std::string> block_size_errors(const Ocp& ocp, const OcpOptions& o) 
   return errors;
 }
 
-std::string step_length_error(const Ocp& ocp) {
+std::string step_length_error(const OcpData& ocp) {
   return core::step_length_error("ocp.T", ocp.T, "ocp.N_stages", ocp.N_stages);
 }
 
@@ -846,8 +628,8 @@ namespace {
 OcpResult solve_impl(const Ocp& ocp, const OcpOptions& options, const std::vector<int>* count,
                      bool* applied) {
   const auto t_start = Clock::now();
-  ocp_detail::require_valid_input(ocp, options);    // src/ocp/ocp_input.cpp, shared with files
-  const StageParameters p = stage_parameters(ocp);  // sizes checked
+  ocp_detail::require_valid_input(ocp, options);  // src/ocp/ocp_input.cpp, shared with files
+  const StageParameters p = ocp_detail::stage_parameters(ocp, ocp.model.p_default);  // checked
 
   std::unique_ptr<OcpNlp> b = build(ocp, options, p);
   mpcc::Problem& mp = b->mpcc;
@@ -910,14 +692,8 @@ OcpResult solve_impl(const Ocp& ocp, const OcpOptions& options, const std::vecto
       *applied = force_allocation(*b, ocp, options, p, *solver, account, hr, *count, res.summary);
     report_held_switches(*b, mp.solution(), res.summary);
   }
-  res.status = hr.status;
-  res.comp_residual = hr.comp_residual;
-  res.summary.max_comp_residual = hr.comp_residual;
+  ocp_detail::set_outcome(hr, res);
   extract(*b, ocp, mp.solution(), p, res);
-  res.message = res.status == Status::Success
-                    ? std::string(describe(Status::Success))
-                    : fmt::format("{} (last IPOPT status {}, complementarity residual {:.2e})",
-                                  describe(hr.status), hr.last_nlp_status, hr.comp_residual);
   if (options.initialization == OcpInitialization::Simulation && !simulated)
     res.message += " [the initializing simulation failed or used another grid: constant guess]";
   res.summary.wall_s = seconds_since(t_start);

@@ -15,6 +15,6 @@ std::vector<std::string> block_size_errors(const Ocp& ocp, const OcpOptions& opt
 
 /// The step rule (core::step_length_error) for the control interval T / N_stages: one message,
 /// or empty.
-std::string step_length_error(const Ocp& ocp);
+std::string step_length_error(const OcpData& ocp);
 
 }  // namespace fesd::ocp_detail

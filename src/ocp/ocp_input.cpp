@@ -11,8 +11,10 @@
 #include <fmt/format.h>
 
 #include "core/option_registry.hpp"
+#include "discretization/pds_interval.hpp"
 #include "fesd/error.hpp"
 #include "ocp/ocp_checks.hpp"
+#include "ocp/ocp_terms.hpp"
 
 namespace fesd::ocp_detail {
 namespace {
@@ -78,7 +80,7 @@ std::string list_of_ints(const std::vector<int>& v) {
 
 /// Ocp::N_FE: one number of finite elements per control interval, each within the range and
 /// rule of [discretization] N_finite_elements.
-void check_N_FE_list(std::vector<std::string>& e, const Ocp& ocp, const OcpOptions& o) {
+void check_N_FE_list(std::vector<std::string>& e, const OcpData& ocp, const OcpOptions& o) {
   if (ocp.N_FE.empty()) return;
   const registry::Option& option =
       *registry::find(registry::Table::Discretization, "N_finite_elements");
@@ -96,13 +98,18 @@ void check_N_FE_list(std::vector<std::string>& e, const Ocp& ocp, const OcpOptio
   }
 }
 
-void check_data(std::vector<std::string>& e, const Ocp& ocp) {
-  const Pss& m = ocp.model;
-  if (m.n_x() < 1) {
+/// The sizes of the model the data must fit.
+struct ModelSizes {
+  int n_x, n_u, n_p;
+  const Eigen::VectorXd& p_default;
+};
+
+void check_data(std::vector<std::string>& e, const OcpData& ocp, const ModelSizes& m) {
+  if (m.n_x < 1) {
     e.push_back("ocp.model: empty (n_x = 0)");
     return;
   }
-  const Eigen::Index n_x = m.n_x(), n_u = m.n_u();
+  const Eigen::Index n_x = m.n_x, n_u = m.n_u;
   const bool x0_ok = check_vector(e, ocp.x0, n_x, "model.x0", "one per state", false);
   if ((ocp.lbx0.size() > 0) != (ocp.ubx0.size() > 0))
     e.push_back("ocp.lbx0, ocp.ubx0: give both (x0 free) or neither (x0 fixed)");
@@ -118,7 +125,7 @@ void check_data(std::vector<std::string>& e, const Ocp& ocp) {
     check_within(e, ocp.x0, ocp.lbx0, ocp.ubx0, "model.x0", "lbx0, ubx0",
                  "with lbx0/ubx0, model.x0 is the guess of the free initial state and must "
                  "satisfy its bounds");
-  check_vector(e, ocp.p.size() > 0 ? ocp.p : m.p_default, m.n_p(), "model.p", "one per parameter",
+  check_vector(e, ocp.p.size() > 0 ? ocp.p : m.p_default, m.n_p, "model.p", "one per parameter",
                false);
   // Per control interval / control grid point: N_stages (+ 1) vectors.
   const auto check_rows = [&](const std::vector<Eigen::VectorXd>& rows, int expected,
@@ -136,8 +143,8 @@ void check_data(std::vector<std::string>& e, const Ocp& ocp) {
     }
   };
   const auto nothing = [](const Eigen::VectorXd&, const std::string&) {};
-  check_rows(ocp.p_stage, ocp.N_stages, "ocp.p_stage", "one per control interval (N_stages)",
-             m.n_p(), "one per parameter", nothing);
+  check_rows(ocp.p_stage, ocp.N_stages, "ocp.p_stage", "one per control interval (N_stages)", m.n_p,
+             "one per parameter", nothing);
   check_rows(ocp.u_guess_stage, ocp.N_stages, "ocp.u_guess", "one per control interval (N_stages)",
              n_u, "one per control", [&](const Eigen::VectorXd& v, const std::string& row) {
                if (u_bounds_ok)
@@ -158,18 +165,19 @@ void check_data(std::vector<std::string>& e, const Ocp& ocp) {
                "ubg_terminal", "one per terminal constraint");
 }
 
-}  // namespace
-
-OcpInputErrors check_input(const Ocp& ocp, const OcpOptions& options) {
+/// The rules common to both kinds of OCP; `data_rules` adds the model's own when the rest holds.
+template <class Problem, class DataRules>
+OcpInputErrors check_common(const Problem& ocp, const OcpOptions& options, const ModelSizes& sizes,
+                            const DataRules& data_rules) {
   OcpInputErrors e;
   registry::OptionTarget target = registry::target_of(options);
-  target.ocp = const_cast<Ocp*>(&ocp);  // read only
+  target.ocp = const_cast<Problem*>(&ocp);  // read only
   e.options = registry::check(registry::Table::Ocp, target);
   check_N_FE_list(e.options, ocp, options);
   for (std::string& s : validate(options)) e.options.push_back(std::move(s));
   if (e.options.empty())  // the smallest control interval, docs/problem-files.md "Limits"
     if (std::string s = step_length_error(ocp); !s.empty()) e.options.push_back(std::move(s));
-  check_data(e.data, ocp);
+  check_data(e.data, ocp, sizes);
   const bool external = options.initialization == OcpInitialization::External;
   if (external && ocp.x_guess.empty())
     e.options.push_back(
@@ -179,15 +187,69 @@ OcpInputErrors check_input(const Ocp& ocp, const OcpOptions& options) {
         fmt::format("ocp.initialization = {}: x_guess is given but used only with initialization = "
                     "external",
                     to_string(options.initialization)));
-  if (e.options.empty() && e.data.empty())  // the limits of the NLP's blocks
-    e.data = block_size_errors(ocp, options);
+  if (e.options.empty() && e.data.empty()) data_rules(e);
   return e;
 }
 
-void require_valid_input(const Ocp& ocp, const OcpOptions& options) {
+template <class Problem>
+void require(const Problem& ocp, const OcpOptions& options) {
   const OcpInputErrors e = check_input(ocp, options);
   if (!e.options.empty()) throw InvalidOption(registry::join(e.options));
   if (!e.data.empty()) throw InvalidModel(registry::join(e.data));
+}
+
+}  // namespace
+
+OcpInputErrors check_input(const Ocp& ocp, const OcpOptions& options) {
+  const Pss& m = ocp.model;
+  return check_common(ocp, options, {m.n_x(), m.n_u(), m.n_p(), m.p_default},
+                      [&](OcpInputErrors& e) {  // the limits of the NLP's blocks
+                        e.data = block_size_errors(ocp, options);
+                      });
+}
+
+OcpInputErrors check_input(const PdsOcp& ocp, const OcpOptions& options) {
+  const Pds& m = ocp.model;
+  return check_common(
+      ocp, options, {m.n_x(), m.n_u(), m.n_p(), m.p_default}, [&](OcpInputErrors& e) {
+        const DiscretizationOptions& d = options.discretization;
+        for (std::string& s :
+             discretization::PdsInterval::errors(make_tableau(d.rk_scheme, d.n_s), d, ocp.pds))
+          e.options.push_back(std::move(s));
+        // Per-interval data of piecewise smooth OCPs that projected ones do not use yet.
+        for (const auto& [given, key] :
+             {std::pair{!ocp.p_stage.empty(), "p_time_var (ocp.p_stage)"},
+              std::pair{!ocp.u_guess_stage.empty(), "u_guess per control interval"},
+              std::pair{options.initialization == OcpInitialization::External,
+                        "initialization = external (x_guess)"}})
+          if (given)
+            e.options.push_back(fmt::format("ocp.{}: not supported for projected models yet", key));
+        if (!ocp.N_FE.empty() && d.use_fesd)
+          for (std::size_t k = 0; k < ocp.N_FE.size(); ++k)
+            if (ocp.N_FE[k] < 2)
+              e.options.push_back(fmt::format(
+                  "discretization.N_finite_elements[{}] = {}: FESD needs >= 2", k, ocp.N_FE[k]));
+        e.data = cost_block_size_errors(ocp, m.n_x(), m.n_u(), m.n_p(), d.n_s);
+        // x0 in C (a fixed x0; a free one is only the guess)
+        const Eigen::VectorXd p = ocp.p.size() > 0 ? ocp.p : m.p_default;
+        if (ocp.lbx0.size() > 0 || !e.data.empty()) return;
+        Eigen::VectorXd c(m.n_c());
+        m.functions().c(ocp.x0.data(), p.data(), c.data());
+        for (int k = 0; k < m.n_c(); ++k)
+          if (!std::isfinite(c[k]) || c[k] < -m.x0_tol)
+            e.data.push_back(
+                fmt::format("model.x0 lies outside C = {{x : c(x) >= 0}}: constraints[{}](x0) = "
+                            "{:.6g} < -x0_tol "
+                            "= {:.3g}",
+                            k, c[k], -m.x0_tol));
+      });
+}
+
+void require_valid_input(const Ocp& ocp, const OcpOptions& options) {
+  require(ocp, options);
+}
+void require_valid_input(const PdsOcp& ocp, const OcpOptions& options) {
+  require(ocp, options);
 }
 
 }  // namespace fesd::ocp_detail

@@ -22,9 +22,12 @@ struct OcpInputErrors {
 
 /// Every input rule of an OCP.
 OcpInputErrors check_input(const Ocp& ocp, const OcpOptions& options);
+/// The same for a projected system, plus its scheme rules (PdsInterval::errors) and x0 in C.
+OcpInputErrors check_input(const PdsOcp& ocp, const OcpOptions& options);
 
 /// Throws InvalidOption with every option message if there is one, else InvalidModel with every
 /// data message if there is one.
 void require_valid_input(const Ocp& ocp, const OcpOptions& options);
+void require_valid_input(const PdsOcp& ocp, const OcpOptions& options);
 
 }  // namespace fesd::ocp_detail

@@ -1,4 +1,5 @@
-// Problem files of projected dynamical systems ([model] kind = "projected", docs/pds.md).
+// Problem files of projected dynamical systems ([model] kind = "projected", docs/pds.md):
+// simulation files, optimal control files and the program on both.
 #include <sys/wait.h>
 
 #include <algorithm>
@@ -7,11 +8,14 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
 #include "../../bench/pds_example1_model.hpp"
 #include "fesd/error.hpp"
+#include "fesd/ocp.hpp"
 #include "fesd/pds_problem_file.hpp"
 #include "fesd/problem_file.hpp"
 #include "support/temp_dir.hpp"
@@ -126,9 +130,9 @@ std::string slurp(const std::string& path) {
   return ss.str();
 }
 
-CliRun fesd_cli(const std::string& args) {
+CliRun fesd_cli(const std::string& args, const std::string& command = "simulate") {
   TempDir dir;
-  const std::string cmd = std::string("'") + FESD_CLI + "' simulate " + args + " >'" +
+  const std::string cmd = std::string("'") + FESD_CLI + "' " + command + " " + args + " >'" +
                           dir.file("out") + "' 2>'" + dir.file("err") + "' </dev/null";
   const int status = std::system(cmd.c_str());
   return {status != -1 && WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(dir.file("out")),
@@ -148,13 +152,63 @@ TEST(PdsCli, SimulateExample1) {
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 22);  // header + 21 element boundaries
 }
 
-TEST(PdsCli, UnsupportedOutputsAndOverridesExitTwo) {
+// --json as for piecewise smooth models: the contact and leaving events, lambda per stage.
+TEST(PdsCli, SimulateExample1Json) {
+  TempDir dir;
+  const CliRun r = fesd_cli(std::string(FESD_SOURCE_DIR) + "/examples/pds_example1.toml --quiet " +
+                            "--json '" + dir.file("r.json") + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string json = slurp(dir.file("r.json"));
+  EXPECT_NE(json.find("\"switch_times\""), std::string::npos);
+  EXPECT_NE(json.find("\"lambda\""), std::string::npos);
+  EXPECT_NE(json.find("\"state_names\": [\"x1\",\"x2\"]"), std::string::npos)
+      << json.substr(0, 400);
+}
+
+TEST(PdsCli, PlotExitsTwo) {
   const std::string file = std::string(FESD_SOURCE_DIR) + "/examples/pds_example1.toml";
-  for (const std::string& extra : {std::string("--json /tmp/x.json"), std::string("--n_s 2")}) {
-    const CliRun r = fesd_cli(file + " " + extra);
-    EXPECT_EQ(r.code, 2) << extra;
-    EXPECT_NE(r.err.find("not supported for projected models"), std::string::npos) << r.err;
+  const CliRun r = fesd_cli(file + " --plot /tmp/x.png");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("not supported for projected models"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+}
+
+// Bad projected files through the program: exit 2 and one line naming the problem.
+TEST(PdsCli, BadFilesExitTwoWithOneLine) {
+  TempDir dir;
+  const std::string file = dir.file("bad.toml");
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {replace(kExample1, "f = [", "fx = ["), "unknown key 'fx'"},
+      {replace(kExample1, "f = [\"x2\", \"-x1\"]", "f = [\"x2\"]"), "model.f: wrong length"},
+      {replace(kExample1, "x0 = [1.4142135623730951, ", "x0 = [nan, "), "must be finite"},
+      {replace(kExample1, "x0 = [1.4142135623730951, 1.4142135623730951]", "x0 = [0.0, -2.0]"),
+       "outside C"},
+      {replace(kExample1, "N_sim = 1", "N_sim = 1\nbogus = 2"), "unknown key 'bogus'"}};
+  for (const auto& [text, what] : cases) {
+    {
+      std::ofstream f(file);
+      f << text;
+    }
+    const CliRun r = fesd_cli("'" + file + "' --quiet");
+    EXPECT_EQ(r.code, 2) << what;
+    EXPECT_NE(r.err.find(what), std::string::npos) << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
+}
+
+// Command-line overrides as for piecewise smooth files; unknown and unsupported keys: exit 2.
+TEST(PdsCli, Overrides) {
+  const std::string file = std::string(FESD_SOURCE_DIR) + "/examples/pds_example1.toml";
+  const CliRun ok =
+      fesd_cli(file + " --n_s 2 --N_FE 10 --x0 1.4142135623730951,1.4142135623730951");
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  EXPECT_NE(ok.out.find("n_s = 2, N_FE = 10"), std::string::npos) << ok.out;
+  for (const std::string& extra :
+       {std::string("--n_S 2"), std::string("--p a=2"), std::string("--tol_sim 1e-3"),
+        std::string("--x0 1,2,3"), std::string("--N_sim 0")}) {
+    const CliRun r = fesd_cli(file + " " + extra);
+    EXPECT_EQ(r.code, 2) << extra << r.out;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << extra << ": " << r.err;
   }
 }
 
@@ -172,6 +226,147 @@ TEST(PdsProblemFile, PiecewiseSmoothLoaderNamesTheKind) {
               std::string::npos)
         << e.what();
   }
+}
+
+}  // namespace
+
+// ---- optimal control files ([model] kind = "projected" with [ocp], docs/pds.md) ----------------
+
+namespace {
+
+// A point driven by u towards -1 and stopped by the wall C = {x >= 0}: it reaches the wall and
+// stays in contact, the cost of u is what keeps it from arriving early.
+const std::string kWall = R"(
+name = "wall"
+[model]
+kind = "projected"
+x = ["x"]
+u = ["u"]
+f = ["u"]
+constraints = ["x"]
+x0 = [1.0]
+[ocp]
+T = 2.0
+N_stages = 4
+f_q = "u^2"
+f_q_T = "(x + 1)^2"
+lbu = [-2]
+ubu = [2]
+[discretization]
+n_s = 2
+N_finite_elements = 2
+)";
+
+template <class E>
+std::string ocp_error_of(const std::string& text) {
+  try {
+    const fesd::PdsOcpProblem q = fesd::parse_pds_ocp_problem(text, "f.toml");
+    (void)fesd::solve(q.ocp, q.options);
+  } catch (const E& e) {
+    return e.what();
+  }
+  return "(no exception)";
+}
+
+TEST(PdsOcpProblemFile, Wall) {
+  const fesd::PdsOcpProblem q = fesd::parse_pds_ocp_problem(kWall, "f.toml");
+  EXPECT_EQ(q.name, "wall");
+  EXPECT_EQ(q.ocp.N_stages, 4);
+  const fesd::OcpResult r = fesd::solve(q.ocp, q.options);
+  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+  EXPECT_LE(r.comp_residual, 1e-9);
+  for (const Eigen::VectorXd& x : r.x_stage) EXPECT_GE(x[0], -1e-9);
+  // The optimum reaches the wall: x(T) = 0 (the terminal cost pulls past it).
+  EXPECT_NEAR(r.x_final()[0], 0.0, 1e-6);
+}
+
+// examples/ocp_pds_discs.toml is the problem of bench/pds_discs_model.hpp (solved in
+// tests/pds/pds_ocp_test.cpp).
+TEST(PdsOcpProblemFile, DiscsExampleReads) {
+  const fesd::PdsOcpProblem q =
+      fesd::load_pds_ocp_problem(std::string(FESD_SOURCE_DIR) + "/examples/ocp_pds_discs.toml");
+  EXPECT_EQ(q.ocp.model.n_x(), 6);
+  EXPECT_EQ(q.ocp.model.n_u(), 4);
+  EXPECT_EQ(q.ocp.model.n_c(), 2);
+  EXPECT_EQ(q.ocp.N_stages, 20);
+  EXPECT_EQ(q.options.discretization.N_FE, 3);
+  EXPECT_EQ(q.options.discretization.n_s, 2);
+  EXPECT_TRUE(q.options.constraints_at_stages);
+  EXPECT_EQ(q.ocp.ubx[0], -2.5);
+  EXPECT_EQ(q.ocp.lbx[2], 2.5);
+  ASSERT_TRUE(q.ocp.functions && q.ocp.functions->has_f_q() && q.ocp.functions->has_f_q_T());
+  Eigen::VectorXd x(6), p(0);
+  x << -10, 0, 10, 0, 0, 10;  // x_T: the Mayer term is 0 there
+  EXPECT_EQ(q.ocp.functions->f_q_T(x.data(), p.data()), 0.0);
+}
+
+TEST(PdsOcpProblemFile, BadInputOneLineEach) {
+  auto has = [](const std::string& m, const std::string& what) {
+    EXPECT_NE(m.find(what), std::string::npos) << m;
+    EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+  };
+  has(ocp_error_of<fesd::ProblemFileError>(replace(kWall, "f_q = ", "fq = ")), "unknown key 'fq'");
+  has(ocp_error_of<fesd::ProblemFileError>(replace(kWall, "lbu = [-2]", "lbu = [-2, 1]")),
+      "ocp.lbu: wrong length");
+  has(ocp_error_of<fesd::ProblemFileError>(replace(kWall, "f_q = \"u^2\"", "f_q = \"u^2 + t\"")),
+      "time t");
+  has(ocp_error_of<fesd::ProblemFileError>(replace(kWall, "x0 = [1.0]", "x0 = [inf]")),
+      "must be finite");
+  has(ocp_error_of<fesd::Error>(replace(kWall, "x0 = [1.0]", "x0 = [-0.5]")), "x0 lies outside C");
+  has(ocp_error_of<fesd::Error>(replace(kWall, "n_s = 2", "n_s = 2\nrk_scheme = \"lobatto_iiic\"")),
+      "lobatto_iiic");
+  has(ocp_error_of<fesd::ProblemFileError>(
+          replace(kWall, "[ocp]", "[simulation]\nT_sim = 1\n[ocp]")),
+      "simulation");
+  // The other loaders name the kind.
+  try {
+    (void)fesd::parse_ocp_problem(kWall, "f.toml");
+    FAIL() << "no exception";
+  } catch (const fesd::ProblemFileError& e) {
+    has(e.what(), "load_pds_ocp_problem");
+  }
+  try {
+    (void)fesd::parse_pds_simulation_problem(kWall, "f.toml");
+    FAIL() << "no exception";
+  } catch (const fesd::ProblemFileError& e) {
+    has(e.what(), "fesd solve");
+  }
+}
+
+TEST(PdsCli, SolveWall) {
+  TempDir dir;
+  const std::string wall = dir.file("wall.toml"), csv_file = dir.file("x.csv"),
+                    json_file = dir.file("r.json"), bad_file = dir.file("bad.toml");
+  {
+    std::ofstream f(wall);
+    f << kWall;
+  }
+  const CliRun r =
+      fesd_cli("'" + wall + "' --csv '" + csv_file + "' --json '" + json_file + "'", "solve");
+  ASSERT_EQ(r.code, 0) << r.err << r.out;
+  EXPECT_NE(r.out.find("optimal control of a projected dynamical system"), std::string::npos);
+  EXPECT_NE(r.out.find("fesd optimal control: success"), std::string::npos) << r.out;
+  const std::string csv = slurp(csv_file);
+  EXPECT_EQ(csv.rfind("t,x,interval,u\n0,1,0,", 0), 0u) << csv;
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 10);  // header + 9 element boundaries
+  const std::string json = slurp(json_file);
+  EXPECT_NE(json.find("\"objective\""), std::string::npos);
+  EXPECT_NE(json.find("\"switches\""), std::string::npos);
+  EXPECT_NE(json.find("\"control_names\": [\"u\"]"), std::string::npos);
+  // An override: 8 control intervals of 2 elements.
+  const CliRun more = fesd_cli("'" + wall + "' --N_stages 8 --csv '" + csv_file + "'", "solve");
+  ASSERT_EQ(more.code, 0) << more.err;
+  const std::string csv8 = slurp(csv_file);
+  EXPECT_EQ(std::count(csv8.begin(), csv8.end(), '\n'), 18);  // header + 17 element boundaries
+  // x0 outside C: bad input, one line, exit 2.
+  {
+    std::ofstream f(bad_file);
+    f << replace(kWall, "x0 = [1.0]", "x0 = [-0.5]");
+  }
+  const CliRun bad = fesd_cli("'" + bad_file + "' --quiet", "solve");
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("outside C"), std::string::npos) << bad.err;
+  EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
 }
 
 }  // namespace

@@ -1,0 +1,36 @@
+// src/io/pds_model_reader.hpp: the [model] table of a projected system ([model] kind =
+// "projected", docs/pds.md "Problem files"), shared by simulation files (pds_problem_file.cpp) and
+// optimal control files (ocp_problem_file.cpp).
+#pragma once
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "fesd/pds.hpp"
+#include "io/problem_file_reader.hpp"
+
+namespace fesd::io_detail {
+
+/// The model as read: the Pds (names and p_default set), [model] x0 and p, and the symbols
+/// [x, t, u, p] of expressions (the time slot t is not supported: expressions reading it are
+/// rejected).
+struct PdsModelRead {
+  Pds model;
+  Eigen::VectorXd x0, p;
+  Symbols sym;
+};
+
+/// Reads [model] (kind, x, u, p, x0, f, constraints, x0_tol); throws fesd::ProblemFileError at
+/// the line of the first mistake (unknown keys, keys of piecewise smooth models, lengths, names).
+PdsModelRead read_pds_model(const Reader& r, const toml::table& root);
+
+/// The overrides of projected files that are not registry options: [ipopt] keys, model.x0 (n_x
+/// numbers), simulation.u (if `u` is given); tol_sim, t0 and p are rejected (InvalidOption).
+/// False for any other key.
+bool set_pds_override(const OverrideArg& a, int n_x, int n_u,
+                      std::vector<std::pair<std::string, std::string>>& ipopt_extra,
+                      Eigen::VectorXd& x0, Eigen::VectorXd* u);
+
+}  // namespace fesd::io_detail

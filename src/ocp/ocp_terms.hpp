@@ -1,0 +1,370 @@
+// src/ocp/ocp_terms.hpp: the parts of a discretized OCP that do not depend on the dynamics, shared
+// by the piecewise smooth OCP (ocp.cpp, FesdInterval) and the projected one (pds_ocp.cpp,
+// PdsInterval): the cost and constraint blocks, the decision variables s0, p and q_k, and
+// add_ocp_terms(), which writes the state bounds, the Lagrange term, the path constraints and the
+// terminal cost and constraints of (59) for any interval type with the layout x(n, j),
+// X(n, i, j), h(n), N_FE(), n_s().
+#pragma once
+#include <algorithm>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <Eigen/Dense>
+
+#include "core/util.hpp"
+#include "fesd/ocp.hpp"
+#include "fesd/tableau.hpp"
+#include "mpcc/problem.hpp"
+#include "nlp/block.hpp"
+#include "nlp/block_nlp.hpp"
+#include "nlp/sum_block.hpp"
+
+namespace fesd::ocp_detail {
+
+inline std::vector<int> range(int first, int n) {
+  std::vector<int> r(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) r[i] = first + i;
+  return r;
+}
+
+// ---- bounds (empty: unbounded) -----------------------------------------------------------------
+inline double lower(const Eigen::VectorXd& lb, Eigen::Index i) {
+  return lb.size() == 0 ? -nlp::kInf : std::max(lb[i], -nlp::kInf);
+}
+inline double upper(const Eigen::VectorXd& ub, Eigen::Index i) {
+  return ub.size() == 0 ? nlp::kInf : std::min(ub[i], nlp::kInf);
+}
+
+// ---- cost and constraint blocks ----------------------------------------------------------------
+
+/// h * sum_j b_j f_q(X_j, q, p): the Lagrange term of one element with the RK quadrature.
+/// inputs: h, X_1 .. X_{n_s} (n_x each), q (n_u), p (n_p)
+struct LagrangeTerm {
+  const OcpFunctions* f;
+  std::vector<double> b;
+  int n_x, n_u, n_p;
+  int num_inputs() const { return 1 + static_cast<int>(b.size()) * n_x + n_u + n_p; }
+  int num_outputs() const { return 1; }
+  template <class T>
+  void operator()(const T* w, T* c) const {
+    const int n_s = static_cast<int>(b.size());
+    const T* q = w + 1 + n_s * n_x;
+    const T* p = q + n_u;
+    T s(0.0);
+    for (int j = 0; j < n_s; ++j) s = s + b[j] * f->f_q(w + 1 + j * n_x, q, p);
+    c[0] = w[0] * s;
+  }
+};
+
+/// f_q_T(x, p).  inputs: x (n_x), p (n_p)
+struct MayerTerm {
+  const OcpFunctions* f;
+  int n_x, n_p;
+  int num_inputs() const { return n_x + n_p; }
+  int num_outputs() const { return 1; }
+  template <class T>
+  void operator()(const T* w, T* c) const {
+    c[0] = f->f_q_T(w, w + n_x);
+  }
+};
+
+/// g_path(x, q, p).  inputs: x (n_x), q (n_u), p (n_p)
+struct PathConstraint {
+  const OcpFunctions* f;
+  int n_x, n_u, n_p, n_g;
+  int num_inputs() const { return n_x + n_u + n_p; }
+  int num_outputs() const { return n_g; }
+  template <class T>
+  void operator()(const T* w, T* c) const {
+    f->g_path(w, w + n_x, w + n_x + n_u, c);
+  }
+};
+
+/// g_terminal(x, p) (soft = false), or with slacks s (soft = true): outputs g - s (<= ub) and
+/// g + s (>= lb).  inputs: x (n_x), p (n_p)[, s (n_g)]
+struct TerminalConstraintEq {
+  const OcpFunctions* f;
+  int n_x, n_p, n_g;
+  bool soft = false;
+  int num_inputs() const { return n_x + n_p + (soft ? n_g : 0); }
+  int num_outputs() const { return soft ? 2 * n_g : n_g; }
+  template <class T>
+  void operator()(const T* w, T* c) const {
+    f->g_terminal(w, w + n_x, c);
+    if (!soft) return;
+    const T* s = w + n_x + n_p;
+    for (int i = 0; i < n_g; ++i) {
+      c[n_g + i] = c[i] + s[i];
+      c[i] = c[i] - s[i];
+    }
+  }
+};
+
+/// The messages of the cost and constraint blocks with more than ad::kMaxInputs inputs (each
+/// starts with the problem-file key to change).
+std::vector<std::string> cost_block_size_errors(const OcpData& ocp, int n_x, int n_u, int n_p,
+                                                int n_s);
+
+// ---- per control interval ----------------------------------------------------------------------
+
+/// The parameter values of every control interval (OcpData::p_stage, or p in each).
+using StageParameters = std::vector<Eigen::VectorXd>;
+
+/// OcpData::p_stage, or N_stages copies of p (model_p_default if p is empty).
+inline StageParameters stage_parameters(const OcpData& ocp, const Eigen::VectorXd& p_default) {
+  if (!ocp.p_stage.empty()) return ocp.p_stage;
+  return StageParameters(static_cast<std::size_t>(ocp.N_stages),
+                         ocp.p.size() > 0 ? ocp.p : p_default);
+}
+
+/// The control guess of interval k: OcpData::u_guess_stage, u_guess, or 0.
+inline Eigen::VectorXd control_guess(const OcpData& ocp, int k, int n_u) {
+  if (!ocp.u_guess_stage.empty()) return ocp.u_guess_stage[static_cast<std::size_t>(k)];
+  return ocp.u_guess.size() > 0 ? ocp.u_guess : Eigen::VectorXd::Zero(n_u);
+}
+
+// ---- the NLP -----------------------------------------------------------------------------------
+
+/// The MPCC of an OCP and where its pieces live, for one interval type (FesdInterval,
+/// PdsInterval).
+template <class Interval>
+struct OcpNlpParts {
+  mpcc::Problem mpcc;
+  Tableau tab;
+  std::vector<int> s0, p;
+  std::vector<std::vector<int>> p_k;  // per interval: p, or its own fixed values (p_stage)
+  std::vector<std::vector<int>> q;    // per interval
+  std::vector<std::unique_ptr<Interval>> iv;
+  std::vector<int> terminal_slacks;
+};
+
+// ---- decision variables ------------------------------------------------------------------------
+
+/// s0 (fixed to x0, or free within [lbx0, ubx0] intersected with [lbx, ubx]), p (fixed to the
+/// first interval's values) and per interval its parameters p_k: p, or (p_stage) their own fixed
+/// variables from interval 1 on.
+inline void add_start_and_parameters(mpcc::Problem& mp, const OcpData& ocp,
+                                     const StageParameters& p_stage, std::vector<int>& s0,
+                                     std::vector<int>& p_vars, std::vector<std::vector<int>>& p_k) {
+  const Eigen::VectorXd& p = p_stage.front();
+  nlp::BlockNlp& nlp = mp.nlp();
+  const int n_x = static_cast<int>(ocp.x0.size());
+  s0 = range(nlp.add_variables(n_x, 0.0, 0.0, 0.0), n_x);
+  mp.fix(s0, ocp.x0);
+  if (ocp.lbx0.size() > 0)
+    for (int i = 0; i < n_x; ++i)
+      mp.bound(s0[i], std::max(lower(ocp.lbx0, i), lower(ocp.lbx, i)),
+               std::min(upper(ocp.ubx0, i), upper(ocp.ubx, i)));
+  p_vars = range(nlp.add_variables(static_cast<int>(p.size()), 0.0, 0.0, 0.0),
+                 static_cast<int>(p.size()));
+  mp.fix(p_vars, p);
+  p_k.assign(1, p_vars);
+  for (std::size_t k = 1; k < p_stage.size(); ++k) {
+    if (ocp.p_stage.empty()) {
+      p_k.push_back(p_vars);
+    } else {
+      p_k.push_back(range(nlp.add_variables(static_cast<int>(p.size()), 0.0, 0.0, 0.0),
+                          static_cast<int>(p.size())));
+      mp.fix(p_k.back(), p_stage[k]);
+    }
+  }
+}
+
+/// q_k of control interval k within [lbu, ubu], its guess control_guess() (clamped).
+inline std::vector<int> add_control(mpcc::Problem& mp, const OcpData& ocp, int n_u, int k) {
+  std::vector<int> q = range(mp.nlp().add_variables(n_u, 0.0, 0.0, 0.0), n_u);
+  const Eigen::VectorXd g = control_guess(ocp, k, n_u);
+  for (int i = 0; i < n_u; ++i) {
+    mp.bound(q[i], lower(ocp.lbu, i), upper(ocp.ubu, i));
+    mp.guess()[q[i]] = std::clamp(g[i], mp.lower(q[i]), mp.upper(q[i]));
+  }
+  return q;
+}
+
+// ---- the terms of (59) -------------------------------------------------------------------------
+
+/// State bounds at every element boundary (and stage point with constraints_at_stages), path
+/// constraints there and at s0, the Lagrange term with the RK quadrature per element, the Mayer
+/// term and the terminal constraints at the end of the last interval (hard, or l1 with the slacks
+/// returned in terminal_slacks). `iv[k]` is the interval of control interval k, `q[k]` its control,
+/// `p_k[k]` its parameters (the terminal terms use the last interval's).
+template <class Interval>
+void add_ocp_terms(mpcc::Problem& mp, const OcpData& ocp, const OcpOptions& o, const Tableau& tab,
+                   int n_x, int n_u, const std::vector<int>& s0,
+                   const std::vector<std::vector<int>>& p_k, const std::vector<std::vector<int>>& q,
+                   const std::vector<std::unique_ptr<Interval>>& iv,
+                   std::vector<int>& terminal_slacks) {
+  nlp::BlockNlp& nlp = mp.nlp();
+  const int n_p = static_cast<int>(p_k.front().size());
+  const OcpFunctions* f = ocp.functions.get();
+  std::vector<double> bw;
+  for (int j = 0; j < tab.n_s; ++j) bw.push_back(tab.b(j));
+  auto lagrange = f && f->has_f_q() ? nlp::make_block(LagrangeTerm{f, bw, n_x, n_u, n_p}) : nullptr;
+  auto path =
+      ocp.n_g_path > 0 ? nlp::make_block(PathConstraint{f, n_x, n_u, n_p, ocp.n_g_path}) : nullptr;
+  std::vector<double> path_lb(ocp.n_g_path), path_ub(ocp.n_g_path);
+  for (int i = 0; i < ocp.n_g_path; ++i) {
+    path_lb[i] = lower(ocp.lbg_path, i);
+    path_ub[i] = upper(ocp.ubg_path, i);
+  }
+  auto bound_state = [&](int first) {
+    for (int i = 0; i < n_x; ++i)
+      mp.bound(first + i, std::max(mp.lower(first + i), lower(ocp.lbx, i)),
+               std::min(mp.upper(first + i), upper(ocp.ubx, i)));
+  };
+  auto add_path = [&](int x_first, const std::vector<int>& qk, const std::vector<int>& pk) {
+    if (!path) return;
+    std::vector<int> vars = range(x_first, n_x);
+    vars.insert(vars.end(), qk.begin(), qk.end());
+    vars.insert(vars.end(), pk.begin(), pk.end());
+    nlp.add_constraint(path, vars, path_lb, path_ub);
+  };
+  add_path(s0[0], q[0], p_k[0]);
+  for (std::size_t k = 0; k < iv.size(); ++k) {
+    const Interval& v = *iv[k];
+    for (int n = 0; n < v.N_FE(); ++n) {
+      bound_state(v.x(n + 1, 0));
+      add_path(v.x(n + 1, 0), q[k], p_k[k]);
+      if (o.constraints_at_stages)
+        for (int s = 0; s < v.n_s(); ++s) {
+          bound_state(v.X(n, s, 0));
+          add_path(v.X(n, s, 0), q[k], p_k[k]);
+        }
+      if (lagrange) {
+        std::vector<int> vars{v.h(n)};
+        for (int s = 0; s < v.n_s(); ++s)
+          for (int i = 0; i < n_x; ++i) vars.push_back(v.X(n, s, i));
+        vars.insert(vars.end(), q[k].begin(), q[k].end());
+        vars.insert(vars.end(), p_k[k].begin(), p_k[k].end());
+        nlp.add_objective(lagrange, vars);
+      }
+    }
+  }
+
+  // ---- terminal cost and constraints at s_N ----
+  const Interval& last = *iv.back();
+  std::vector<int> xp = range(last.x(last.N_FE(), 0), n_x);
+  xp.insert(xp.end(), p_k.back().begin(), p_k.back().end());
+  if (f && f->has_f_q_T()) nlp.add_objective(nlp::make_block(MayerTerm{f, n_x, n_p}), xp);
+  if (ocp.n_g_terminal > 0) {
+    const int n_g = ocp.n_g_terminal;
+    std::vector<double> lb(n_g), ub(n_g);
+    for (int i = 0; i < n_g; ++i) {
+      lb[i] = lower(ocp.lbg_terminal, i);
+      ub[i] = upper(ocp.ubg_terminal, i);
+    }
+    if (ocp.terminal_constraint == TerminalConstraint::Hard) {
+      nlp.add_constraint(nlp::make_block(TerminalConstraintEq{f, n_x, n_p, n_g, false}), xp, lb,
+                         ub);
+    } else {  // l1: g - s <= ub, g + s >= lb, rho * sum s
+      terminal_slacks = range(nlp.add_variables(n_g, 0.0, nlp::kInf, 0.0), n_g);
+      std::vector<int> vars = xp;
+      vars.insert(vars.end(), terminal_slacks.begin(), terminal_slacks.end());
+      std::vector<double> lb2(2 * n_g, -nlp::kInf), ub2(2 * n_g, nlp::kInf);
+      for (int i = 0; i < n_g; ++i) {
+        ub2[i] = ub[i];
+        lb2[n_g + i] = lb[i];
+      }
+      nlp.add_constraint(nlp::make_block(TerminalConstraintEq{f, n_x, n_p, n_g, true}), vars, lb2,
+                         ub2);
+      nlp.add_objective(nlp::make_block(nlp::Sum{n_g}), terminal_slacks, ocp.rho_terminal);
+    }
+  }
+}
+
+/// The OCP's own cost at a solution: the Lagrange term with the RK quadrature of each element
+/// (h_n, its stage states, the interval's control and parameters), the Mayer term at x_final (the
+/// last interval's parameters), the l1 penalty.
+class CostSum {
+ public:
+  CostSum(const OcpData& ocp, const Tableau& tab, const StageParameters& p)
+      : ocp_(ocp), tab_(tab), p_(p) {}
+  /// One element of control interval k: h_n sum_j b_j f_q(X_j, q, p_k).
+  void element(double h, const std::vector<Eigen::VectorXd>& X, const Eigen::VectorXd& q,
+               std::size_t k) {
+    const OcpFunctions* f = ocp_.functions.get();
+    if (!f || !f->has_f_q()) return;
+    double quad = 0;
+    for (int s = 0; s < tab_.n_s; ++s)
+      quad += tab_.b(s) * f->f_q(X[s].data(), q.data(), p_[k].data());
+    sum_ += h * quad;
+  }
+  double total(const Eigen::VectorXd& x_final, const std::vector<double>& w,
+               const std::vector<int>& terminal_slacks) const {
+    const OcpFunctions* f = ocp_.functions.get();
+    double s = sum_;
+    if (f && f->has_f_q_T()) s += f->f_q_T(x_final.data(), p_.back().data());
+    for (int v : terminal_slacks) s += ocp_.rho_terminal * w[v];
+    return s;
+  }
+
+ private:
+  const OcpData& ocp_;
+  const Tableau& tab_;
+  const StageParameters& p_;
+  double sum_ = 0;
+};
+
+/// The result of the NLP point w: grid, states, controls, stage points, active sets, switches,
+/// the OCP's own objective. For any interval type with active_set(w, n); `per_stage(v, n, s)`
+/// appends the interval kind's algebraic variables of one stage, `eta_of(v)` gives one entry per
+/// element of OcpResult::eta.
+template <class Interval, class PerStage, class EtaOf>
+void extract_result(const OcpData& ocp, const Tableau& tab, int n_x, int n_u,
+                    const std::vector<int>& s0, const std::vector<std::vector<int>>& q,
+                    const std::vector<std::unique_ptr<Interval>>& iv,
+                    const std::vector<int>& terminal_slacks, const std::vector<double>& w,
+                    const StageParameters& p, OcpResult& res, const PerStage& per_stage,
+                    const EtaOf& eta_of) {
+  const double T_k = ocp.T / ocp.N_stages;
+  double t = 0;
+  res.t = {0.0};
+  res.x = {util::gather(w, s0[0], n_x)};
+  CostSum objective(ocp, tab, p);
+  for (std::size_t k = 0; k < iv.size(); ++k) {
+    const Interval& v = *iv[k];
+    const Eigen::VectorXd qk = util::gather(w, q[k].empty() ? 0 : q[k][0], n_u);
+    res.u.push_back(qk);
+    res.t_ctrl.push_back(static_cast<double>(k) * T_k);
+    const std::vector<double> eta = eta_of(v);
+    for (int n = 0; n < v.N_FE(); ++n) {
+      const double hn = w[v.h(n)];
+      const std::vector<int> active = v.active_set(w.data(), n);
+      std::vector<Eigen::VectorXd> X;
+      for (int s = 0; s < v.n_s(); ++s) {
+        res.t_stage.push_back(t + tab.c(s) * hn);
+        X.push_back(util::gather(w, v.X(n, s, 0), n_x));
+        res.x_stage.push_back(X.back());
+        per_stage(v, n, s);
+      }
+      objective.element(hn, X, qk, k);
+      if (!res.active_set.empty() && res.active_set.back() != active)
+        res.switches.push_back(
+            {t, static_cast<int>(res.h.size()) - 1, res.active_set.back(), active});
+      res.active_set.push_back(active);
+      res.h.push_back(hn);
+      res.interval.push_back(static_cast<int>(k));
+      res.eta.push_back(eta[static_cast<std::size_t>(n)]);
+      t += hn;
+      res.t.push_back(t);
+      res.x.push_back(util::gather(w, v.x(n + 1, 0), n_x));
+    }
+  }
+  res.t_ctrl.push_back(ocp.T);
+  res.objective = objective.total(res.x.back(), w, terminal_slacks);
+}
+
+/// The outcome of the homotopy in the result: status, complementarity residual, message.
+inline void set_outcome(const mpcc::HomotopyResult& hr, OcpResult& res) {
+  res.status = hr.status;
+  res.comp_residual = hr.comp_residual;
+  res.summary.max_comp_residual = hr.comp_residual;
+  res.message = res.status == Status::Success
+                    ? std::string(describe(Status::Success))
+                    : fmt::format("{} (last IPOPT status {}, complementarity residual {:.2e})",
+                                  describe(hr.status), hr.last_nlp_status, hr.comp_residual);
+}
+
+}  // namespace fesd::ocp_detail
