@@ -376,16 +376,28 @@ PdsOcpProblem parse_pds_ocp_problem(std::string_view toml_text, std::string_view
   return problem;
 }
 
+namespace {
+/// The overrides both kinds of OCP file take the same way: the registry's scalars (N_FE: one
+/// number for every control interval now) and u_guess (one guess for every interval now).
+template <class Problem>
+bool set_ocp_override(const OverrideArg& arg, Problem& updated) {
+  if (set_scalar_override(arg, target_of(updated))) {
+    if (arg.option->key == "N_finite_elements") updated.ocp.N_FE.clear();
+    return true;
+  }
+  if (arg.option == nullptr || arg.option->key != "u_guess") return false;
+  updated.ocp.u_guess = override_vector(arg.head, arg.value, updated.ocp.model.n_u(), "ocp.u_guess",
+                                        "one per control in model.u");
+  updated.ocp.u_guess_stage.clear();
+  return true;
+}
+}  // namespace
+
 void apply_override(PdsOcpProblem& problem, std::string_view key, std::string_view value) {
   const OverrideArg arg = parse_override_arg(key, value, kKind);
   PdsOcpProblem updated = problem;
-  if (set_scalar_override(arg, target_of(updated))) {
-    // One number for every control interval replaces a per-interval list.
-    if (arg.option->key == "N_finite_elements") updated.ocp.N_FE.clear();
-  } else if (arg.option != nullptr && arg.option->key == "u_guess") {
-    updated.ocp.u_guess = override_vector(arg.head, arg.value, updated.ocp.model.n_u(),
-                                          "ocp.u_guess", "one per control in model.u");
-    updated.ocp.u_guess_stage.clear();  // one guess for every interval now
+  if (set_ocp_override(arg, updated)) {
+    // registry option or u_guess
   } else if (!set_pds_override(arg, updated.ocp.model.n_x(), updated.ocp.model.n_u(),
                                updated.options.nlp.extra, updated.ocp.x0, nullptr)) {
     unknown_override(arg, kKind, Pss{});
@@ -412,13 +424,8 @@ ProblemKind problem_file_kind(const std::string& path) {
 void apply_override(OcpProblem& problem, std::string_view key, std::string_view value) {
   const OverrideArg arg = parse_override_arg(key, value, kKind);
   OcpProblem updated = problem;
-  if (set_scalar_override(arg, target_of(updated))) {
-    // One number for every control interval replaces a per-interval list.
-    if (arg.option->key == "N_finite_elements") updated.ocp.N_FE.clear();
-  } else if (arg.option != nullptr && arg.option->key == "u_guess") {
-    updated.ocp.u_guess = override_vector(arg.head, arg.value, updated.ocp.model.n_u(),
-                                          "ocp.u_guess", "one per control in model.u");
-    updated.ocp.u_guess_stage.clear();  // one guess for every interval now
+  if (set_ocp_override(arg, updated)) {
+    // registry option or u_guess
   } else if (set_model_override(arg, updated.ocp.model, updated.has_clock, updated.ocp.x0,
                                 updated.ocp.p)) {
     // [model] x0 (the guess of a free x0) or one parameter
