@@ -55,6 +55,13 @@ void write_json(const IntegratorResult& result, const Pds& model, const std::str
 void write_csv(const IntegratorResult& result, const Pds& model, const std::string& path);
 void write_json(const OcpResult& result, const Pds& model, const std::string& path);
 void write_csv(const OcpResult& result, const Pds& model, const std::string& path);
+/// The same plots for projected dynamical systems: the elements in contact (some constraint
+/// active) shaded, contact and leaving times dashed and labelled ("{}->{0}": constraint 0 becomes
+/// active), and for two states a phase portrait with the boundary pieces c_k(x) = 0 of C.
+void write_plot(const IntegratorResult& result, const Pds& model, const std::string& path,
+                const std::string& title = "");
+void write_plot(const OcpResult& result, const Pds& model, const std::string& path,
+                const std::string& title = "");
 
 /// Throws fesd::IoError if gnuplot, which write_plot runs, is not on PATH: lets a front end fail
 /// before a long solve instead of after it. write_plot checks this itself.

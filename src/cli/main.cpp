@@ -550,8 +550,7 @@ int finish(const Result& result, const std::string& report, const Model& model,
   };
   write("--json", args.json, "JSON", [&] { fesd::write_json(result, model, args.json); });
   write("--csv", args.csv, "CSV ", [&] { fesd::write_csv(result, model, args.csv); });
-  if constexpr (std::is_same_v<Model, fesd::Pss>)  // projected models: rejected before solving
-    write("--plot", args.plot, "plot", [&] { fesd::write_plot(result, model, args.plot, title); });
+  write("--plot", args.plot, "plot", [&] { fesd::write_plot(result, model, args.plot, title); });
   flush_stdout();
 
   if (!io_errors.empty()) {
@@ -598,13 +597,6 @@ Problem prepare(const SolveArgs& args, const CLI::App& cmd) {
   return problem;
 }
 
-/// Plots are not supported for projected models yet (exit 2).
-void reject_pds_outputs(const SolveArgs& args, const CLI::App& cmd) {
-  if (cmd.count("--plot") > 0)
-    throw UsageError(
-        "--plot is not supported for projected models ([model] kind = \"projected\") yet");
-  check_outputs(args, cmd);
-}
 
 /// The first lines of the header of a projected file: name, source, what it is, sizes,
 /// description, x0 and the scheme.
@@ -622,7 +614,7 @@ void print_pds_header(const Problem& problem, std::string_view what, const std::
 /// `fesd simulate` of a projected dynamical system ([model] kind = "projected", docs/pds.md): the
 /// header, integrate() and the report; --json and --csv as for piecewise smooth models.
 int run_simulate_pds(const SolveArgs& args, const CLI::App& cmd) {
-  reject_pds_outputs(args, cmd);
+  check_outputs(args, cmd);
   fesd::PdsSimulationProblem problem = fesd::load_pds_simulation_problem(args.file);
   fesd::apply_overrides(problem, args.overrides.pairs());
   if (!args.quiet) {
@@ -658,7 +650,7 @@ int run_simulate(const SolveArgs& args, const CLI::App& cmd) {
 /// homotopy table as progress, solve() and the report; --json and --csv as for piecewise smooth
 /// OCPs.
 int run_solve_pds(const SolveArgs& args, const CLI::App& cmd) {
-  reject_pds_outputs(args, cmd);
+  check_outputs(args, cmd);
   fesd::PdsOcpProblem problem = fesd::load_pds_ocp_problem(args.file);
   fesd::apply_overrides(problem, args.overrides.pairs());
   const fesd::PdsOcp& ocp = problem.ocp;

@@ -52,8 +52,8 @@ std::string padded_yrange(double lo, double hi) {
   return "set yrange [" + gp_number(lo - pad) + ":" + gp_number(hi + pad) + "]\n";
 }
 
-std::string make_script(const OcpResult& r, const Pss& model, const std::string& path,
-                        const std::string& title) {
+std::string make_script(const OcpResult& r, const io_detail::PlotModel& model,
+                        const std::string& path, const std::string& title) {
   const std::size_t n_points = std::min(r.t.size(), r.x.size());
   const std::size_t n_x = static_cast<std::size_t>(r.x[0].size());
   const std::size_t n_u = r.u.empty() ? 0 : static_cast<std::size_t>(r.u[0].size());
@@ -189,7 +189,7 @@ std::string make_script(const OcpResult& r, const Pss& model, const std::string&
       (r.switches.empty()
            ? std::string("NaN notitle")
            : std::string("NaN with lines dashtype 2 linecolor rgb '#707070' title 'switches'")) +
-      (sliding.empty() ? "" : io_detail::sliding_key_entry());
+      (sliding.empty() ? "" : io_detail::sliding_key_entry(model.shaded_name));
 
   // 1. states.
   s += place(panels[next++], std::max(2.0, 1.0 + 1.2 * label_rows), 0.5);
@@ -279,17 +279,29 @@ std::string make_script(const OcpResult& r, const Pss& model, const std::string&
 
 }  // namespace
 
-std::string io_detail::plot_script(const OcpResult& r, const Pss& model, const std::string& path,
-                                   const std::string& title) {
+std::string io_detail::plot_script(const OcpResult& r, const io_detail::PlotModel& model,
+                                   const std::string& path, const std::string& title) {
   return make_script(r, model, path, title);
 }
 
-void write_plot(const OcpResult& result, const Pss& model, const std::string& path,
-                const std::string& title) {
+namespace {
+void write_ocp_plot(const OcpResult& result, const io_detail::PlotModel& model,
+                    const std::string& path, const std::string& title) {
   io_detail::terminal_for(path, 1000, 1000);  // the extension is checked first
   if (std::min(result.t.size(), result.x.size()) == 0)
     throw IoError("cannot plot to '" + path + "': the result has no time points");
   io_detail::run_plot_script(path, make_script(result, model, path, title));
+}
+}  // namespace
+
+void write_plot(const OcpResult& result, const Pss& model, const std::string& path,
+                const std::string& title) {
+  write_ocp_plot(result, model, path, title);
+}
+
+void write_plot(const OcpResult& result, const Pds& model, const std::string& path,
+                const std::string& title) {
+  write_ocp_plot(result, model, path, title);
 }
 
 }  // namespace fesd

@@ -21,8 +21,8 @@
 namespace fesd {
 namespace io_detail {
 
-std::string plot_script(const IntegratorResult& result, const Pss& model, const std::string& path,
-                        const std::string& title) {
+std::string plot_script(const IntegratorResult& result, const PlotModel& model,
+                        const std::string& path, const std::string& title) {
   const std::size_t n_points = std::min(result.t.size(), result.x.size());
   const std::size_t n_x = n_points > 0 ? static_cast<std::size_t>(result.x[0].size()) : 0;
   const std::vector<std::string> names = names_or_default(model.state_names, n_x, "x");
@@ -89,7 +89,7 @@ std::string plot_script(const IntegratorResult& result, const Pss& model, const 
   s += result.switches.empty()
            ? "NaN notitle"
            : "NaN with lines dashtype 2 linecolor rgb '#707070' title 'switches'";
-  s += sliding.empty() ? "\n" : sliding_key_entry() + "\n";
+  s += sliding.empty() ? "\n" : sliding_key_entry(model.shaded_name) + "\n";
   s += "unset label\n";
 
   // Bottom panel: the step sizes.
@@ -123,13 +123,25 @@ std::string plot_script(const IntegratorResult& result, const Pss& model, const 
 
 }  // namespace io_detail
 
-void write_plot(const IntegratorResult& result, const Pss& model, const std::string& path,
-                const std::string& title) {
+namespace {
+void write_integrator_plot(const IntegratorResult& result, const io_detail::PlotModel& model,
+                           const std::string& path, const std::string& title) {
   io_detail::terminal_for(path, 1000, 700);  // the extension is checked first
   if (std::min(result.t.size(), result.x.size()) == 0) {
     throw IoError("cannot plot to '" + path + "': the result has no time points");
   }
   io_detail::run_plot_script(path, io_detail::plot_script(result, model, path, title));
+}
+}  // namespace
+
+void write_plot(const IntegratorResult& result, const Pss& model, const std::string& path,
+                const std::string& title) {
+  write_integrator_plot(result, model, path, title);
+}
+
+void write_plot(const IntegratorResult& result, const Pds& model, const std::string& path,
+                const std::string& title) {
+  write_integrator_plot(result, model, path, title);
 }
 
 }  // namespace fesd

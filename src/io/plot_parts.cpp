@@ -59,6 +59,52 @@ std::string step_reference_label(const StepAxis& axis, double graph_y) {
       axis.reference, number(graph_y));
 }
 
+// ---- the model as the plots see it --------------------------------------------------------------
+
+PlotModel::PlotModel(const Pss& model)
+    : state_names(model.state_names),
+      control_names(model.control_names),
+      n_x(model.n_x()),
+      p(model.p_default),
+      shaded_name("sliding"),
+      shaded([&model](const std::vector<int>& a) { return is_sliding(model, a); }),
+      surfaces([&model](double xlo, double xhi, double ylo, double yhi, int n_grid) {
+        return switching_surfaces(model, model.p_default, xlo, xhi, ylo, yhi, n_grid);
+      }) {}
+
+PlotModel::PlotModel(const Pds& model)
+    : state_names(model.state_names),
+      control_names(model.control_names),
+      n_x(model.n_x()),
+      p(model.p_default),
+      shaded_name("contact"),
+      shaded([](const std::vector<int>& a) { return !a.empty(); }),
+      surfaces([&model](double xlo, double xhi, double ylo, double yhi, int n_grid) {
+        // The boundary pieces c_k(x) = 0 of C = {x : c(x) >= 0}.
+        Surfaces out;
+        const Eigen::VectorXd& pd = model.p_default;
+        if (model.n_x() != 2 || pd.size() != model.n_p() || n_grid < 2) return out;
+        const auto n_c = static_cast<std::size_t>(model.n_c());
+        std::vector<Eigen::MatrixXd> values(n_c, Eigen::MatrixXd(n_grid, n_grid));
+        std::vector<double> c(n_c);
+        try {
+          for (int i = 0; i < n_grid; ++i)
+            for (int j = 0; j < n_grid; ++j) {
+              const std::array<double, 2> x{xlo + (xhi - xlo) * i / (n_grid - 1),
+                                            ylo + (yhi - ylo) * j / (n_grid - 1)};
+              model.functions().c(x.data(), pd.size() > 0 ? pd.data() : nullptr, c.data());
+              for (std::size_t k = 0; k < n_c; ++k) values[k](i, j) = c[k];
+            }
+        } catch (const std::exception&) {
+          return Surfaces{};
+        }
+        for (std::size_t k = 0; k < n_c; ++k) {
+          std::vector<Segment> seg = zero_contour(values[k], xlo, xhi, ylo, yhi);
+          if (!seg.empty()) out.emplace_back(fmt::format("c[{}] = 0", k), std::move(seg));
+        }
+        return out;
+      }) {}
+
 // ---- sliding intervals -------------------------------------------------------------------------
 
 bool is_sliding(const Pss& model, const std::vector<int>& active_set) {
@@ -72,13 +118,12 @@ bool is_sliding(const Pss& model, const std::vector<int>& active_set) {
 }
 
 std::vector<std::pair<double, double>> sliding_intervals(
-    const Pss& model, const std::vector<double>& t,
+    const PlotModel& model, const std::vector<double>& t,
     const std::vector<std::vector<int>>& active_set) {
   std::vector<std::pair<double, double>> out;
   const std::size_t n_el = std::min(active_set.size(), t.empty() ? 0 : t.size() - 1);
   for (std::size_t n = 0; n < n_el; ++n) {
-    if (!is_sliding(model, active_set[n]) || !std::isfinite(t[n]) || !std::isfinite(t[n + 1]))
-      continue;
+    if (!model.shaded(active_set[n]) || !std::isfinite(t[n]) || !std::isfinite(t[n + 1])) continue;
     if (!out.empty() && out.back().second == t[n]) {
       out.back().second = t[n + 1];
     } else {
@@ -100,10 +145,10 @@ std::string shade_intervals(const std::vector<std::pair<double, double>>& interv
   return s;
 }
 
-std::string sliding_key_entry() {
+std::string sliding_key_entry(const std::string& name) {
   return fmt::format(
-      ", keyentry with boxes fillstyle solid 0.35 noborder fillcolor rgb '{}' title 'sliding'",
-      kSlidingColor);
+      ", keyentry with boxes fillstyle solid 0.35 noborder fillcolor rgb '{}' title '{}'",
+      kSlidingColor, name);
 }
 
 // ---- switches ----------------------------------------------------------------------------------
@@ -231,7 +276,7 @@ std::vector<Segment> zero_contour(const Eigen::MatrixXd& v, double xlo, double x
   return out;
 }
 
-bool wants_phase_portrait(const Pss& model, int n_x) {
+bool wants_phase_portrait(const PlotModel& model, int n_x) {
   if (n_x != 2) return false;
   for (int i = 0; i < 2; ++i) {
     const auto k = static_cast<std::size_t>(i);
@@ -240,12 +285,12 @@ bool wants_phase_portrait(const Pss& model, int n_x) {
   return true;
 }
 
-PhaseData phase_data(const IntegratorResult& r, const Pss& model) {
-  return {r.t, r.x, r.t_stage, r.x_stage, r.active_set, r.switches, model.p_default};
+PhaseData phase_data(const IntegratorResult& r, const PlotModel& model) {
+  return {r.t, r.x, r.t_stage, r.x_stage, r.active_set, r.switches, model.p};
 }
 
-PhaseData phase_data(const OcpResult& r, const Pss& model) {
-  return {r.t, r.x, r.t_stage, r.x_stage, r.active_set, r.switches, model.p_default};
+PhaseData phase_data(const OcpResult& r, const PlotModel& model) {
+  return {r.t, r.x, r.t_stage, r.x_stage, r.active_set, r.switches, model.p};
 }
 
 std::vector<std::pair<std::string, std::vector<Segment>>> switching_surfaces(
@@ -312,8 +357,9 @@ std::vector<std::pair<std::string, std::vector<Segment>>> switching_surfaces(
   return out;
 }
 
-std::string phase_portrait(const Pss& model, const PhaseData& d, double origin_x, double origin_y,
-                           double width, double height, int canvas_w, int canvas_h) {
+std::string phase_portrait(const PlotModel& model, const PhaseData& d, double origin_x,
+                           double origin_y, double width, double height, int canvas_w,
+                           int canvas_h) {
   // The trajectory through the boundary and stage points, in time order.
   std::vector<std::tuple<double, double, double>> pts;
   const auto add = [&](const std::vector<double>& t, const std::vector<Eigen::VectorXd>& x) {
@@ -381,7 +427,7 @@ std::string phase_portrait(const Pss& model, const PhaseData& d, double origin_x
   }
   s += "EOD\n";
 
-  const auto surfaces = switching_surfaces(model, d.p, xlo, xhi, ylo, yhi);
+  const Surfaces surfaces = model.surfaces(xlo, xhi, ylo, yhi, 161);
   for (std::size_t i = 0; i < surfaces.size(); ++i) {
     s += fmt::format("$surface{} << EOD\n", i);
     for (const Segment& g : surfaces[i].second)
@@ -429,8 +475,8 @@ std::string phase_portrait(const Pss& model, const PhaseData& d, double origin_x
   }
   if (any_sliding)
     plot += fmt::format(
-        "$phase_sliding using 1:2 with lines linewidth 7 linecolor rgb '{}' title 'sliding', ",
-        kSlidingColor);
+        "$phase_sliding using 1:2 with lines linewidth 7 linecolor rgb '{}' title '{}', ",
+        kSlidingColor, model.shaded_name);
   plot += "$phase using 1:2 with lines linewidth 2 linecolor rgb '#1f77b4' title 'x(t)', ";
   if (any_switch)
     plot +=

@@ -3,6 +3,7 @@
 // of a two-state system with its switching surfaces. Each part returns gnuplot script text (or
 // the numbers it is made from, for the tests). Internal to src/io.
 #pragma once
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -12,6 +13,7 @@
 #include "fesd/integrator.hpp"
 #include "fesd/model.hpp"
 #include "fesd/ocp.hpp"
+#include "fesd/pds.hpp"
 #include "fesd/summary.hpp"
 
 namespace fesd::io_detail {
@@ -40,20 +42,42 @@ std::string step_ylabel(const StepAxis& axis);
 /// at height graph_y (below the key); empty otherwise.
 std::string step_reference_label(const StepAxis& axis, double graph_y);
 
+// ---- the model as the plots see it --------------------------------------------------------------
+
+struct Segment;
+using Surfaces = std::vector<std::pair<std::string, std::vector<Segment>>>;
+
+/// What the plots need of a model, for piecewise smooth systems (Pss) and projected ones (Pds):
+/// names, parameter values, which elements to shade (sliding; for a projected system: in
+/// contact, some constraint active) and the curves of the phase portrait (switching surfaces;
+/// the boundary pieces c_k = 0 of C).
+struct PlotModel {
+  PlotModel(const Pss& model);  // NOLINT(google-explicit-constructor): plots take either model
+  PlotModel(const Pds& model);  // NOLINT(google-explicit-constructor)
+  std::vector<std::string> state_names, control_names;
+  int n_x = 0;
+  Eigen::VectorXd p;        ///< p_default
+  std::string shaded_name;  ///< "sliding" or "contact"
+  std::function<bool(const std::vector<int>& active_set)> shaded;
+  std::function<Surfaces(double xlo, double xhi, double ylo, double yhi, int n_grid)> surfaces;
+};
+
 // ---- sliding intervals -------------------------------------------------------------------------
 
 /// Whether element n is sliding: some subsystem of `model` has more than one active region in
 /// `active_set[n]` (a Filippov sliding mode, or a crossing inside an element without FESD).
 bool is_sliding(const Pss& model, const std::vector<int>& active_set);
-/// [t_start, t_end] of every maximal run of sliding elements (element n spans [t[n], t[n+1]]).
+/// [t_start, t_end] of every maximal run of shaded elements (sliding, or in contact for a
+/// projected system; element n spans [t[n], t[n+1]]).
 std::vector<std::pair<double, double>> sliding_intervals(
-    const Pss& model, const std::vector<double>& t,
+    const PlotModel& model, const std::vector<double>& t,
     const std::vector<std::vector<int>>& active_set);
 /// gnuplot rectangles shading the intervals in every later panel (objects 1, 2, ...), drawn
 /// behind the data.
 std::string shade_intervals(const std::vector<std::pair<double, double>>& intervals);
-/// A key entry for the shading ("sliding"), to be appended to a plot command (starts with ", ").
-std::string sliding_key_entry();
+/// A key entry for the shading (`name`: "sliding", "contact"), to be appended to a plot command
+/// (starts with ", ").
+std::string sliding_key_entry(const std::string& name = "sliding");
 constexpr const char* kSlidingColor = "#f2c46d";
 
 // ---- switches ----------------------------------------------------------------------------------
@@ -86,7 +110,7 @@ std::vector<Segment> zero_contour(const Eigen::MatrixXd& values, double xlo, dou
                                   double yhi);
 
 /// Whether a phase portrait is drawn: exactly two states, neither named "t" (a clock).
-bool wants_phase_portrait(const Pss& model, int n_x);
+bool wants_phase_portrait(const PlotModel& model, int n_x);
 
 /// Everything the phase portrait needs from a result.
 struct PhaseData {
@@ -98,8 +122,8 @@ struct PhaseData {
   std::vector<SwitchEvent> switches;
   Eigen::VectorXd p;  ///< parameter values for c and g (model.p_default)
 };
-PhaseData phase_data(const IntegratorResult& r, const Pss& model);
-PhaseData phase_data(const OcpResult& r, const Pss& model);
+PhaseData phase_data(const IntegratorResult& r, const PlotModel& model);
+PhaseData phase_data(const OcpResult& r, const PlotModel& model);
 
 /// The switching surfaces of `model` in the box: for each c-form subsystem the zero sets
 /// c_j(x) = 0, for each g-form subsystem the boundaries g_i = g_j where both are smallest; one
@@ -115,16 +139,17 @@ std::vector<std::pair<std::string, std::vector<Segment>>> switching_surfaces(
 /// colour, the start (circle) and end (square), the states at the switches, and the switching
 /// surfaces over the trajectory's bounding box. Unsets arrows, objects and labels of the time
 /// panels first.
-std::string phase_portrait(const Pss& model, const PhaseData& d, double origin_x, double origin_y,
-                           double width, double height, int canvas_w, int canvas_h);
+std::string phase_portrait(const PlotModel& model, const PhaseData& d, double origin_x,
+                           double origin_y, double width, double height, int canvas_w,
+                           int canvas_h);
 
 // ---- the whole scripts -------------------------------------------------------------------------
 
 /// The gnuplot scripts of write_plot (plot.cpp, ocp_plot.cpp): terminal, data, panels. Throws
 /// IoError for an unsupported extension. Exposed for the tests.
-std::string plot_script(const IntegratorResult& result, const Pss& model, const std::string& path,
-                        const std::string& title);
-std::string plot_script(const OcpResult& result, const Pss& model, const std::string& path,
+std::string plot_script(const IntegratorResult& result, const PlotModel& model,
+                        const std::string& path, const std::string& title);
+std::string plot_script(const OcpResult& result, const PlotModel& model, const std::string& path,
                         const std::string& title);
 
 }  // namespace fesd::io_detail

@@ -18,6 +18,7 @@
 #include "fesd/ocp.hpp"
 #include "fesd/pds_problem_file.hpp"
 #include "fesd/problem_file.hpp"
+#include "io/plot_parts.hpp"
 #include "support/temp_dir.hpp"
 
 namespace {
@@ -165,12 +166,24 @@ TEST(PdsCli, SimulateExample1Json) {
       << json.substr(0, 400);
 }
 
-TEST(PdsCli, PlotExitsTwo) {
+// --plot of a projected run: the program writes the picture; its script shades the contact phase,
+// labels the contact and leaving switches and draws the boundary c = 0 in the phase portrait.
+TEST(PdsCli, PlotOfExample1) {
+  TempDir dir;
   const std::string file = std::string(FESD_SOURCE_DIR) + "/examples/pds_example1.toml";
-  const CliRun r = fesd_cli(file + " --plot /tmp/x.png");
-  EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("not supported for projected models"), std::string::npos) << r.err;
-  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  const std::string png = dir.file("pds.png");
+  const CliRun r = fesd_cli(file + " --plot " + png);
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream in(png, std::ios::binary);
+  in.seekg(0, std::ios::end);
+  EXPECT_GT(in.tellg(), 10000);
+
+  const fesd::PdsSimulationProblem p = fesd::load_pds_simulation_problem(file);
+  const fesd::IntegratorResult result = fesd::simulate(p);
+  const std::string s = fesd::io_detail::plot_script(result, p.model, "out.png", "");
+  for (const char* part : {"title 'contact'", "'c[0] = 0'", "{}->{0}", "{0}->{}", "phase portrait"})
+    EXPECT_NE(s.find(part), std::string::npos) << part;
+  EXPECT_EQ(s.find("'sliding'"), std::string::npos);
 }
 
 // Bad projected files through the program: exit 2 and one line naming the problem.
