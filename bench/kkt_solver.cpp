@@ -12,6 +12,11 @@
 //
 //   kkt_solver [--stages 6,12,24] [--solvers dense,mumps,sparse_ldl] [--dense-max 1000]
 //              [--stride 7] [--matrices 40] [--repeat 5] [--csv FILE] [--json FILE]
+//              [--save DIR]
+//
+// --save DIR writes each N_stages' timed matrices to DIR/kkt_N.bin (int count; per matrix: int n,
+// int nz, nz ints irn, nz ints icn, nz doubles a; 1-based, as captured), for profiling the
+// factorization alone (callgrind) outside IPOPT.
 #include <dlfcn.h>
 
 #include <algorithm>
@@ -44,7 +49,8 @@ void usage(const std::string& why, int exit_code) {
                "usage: kkt_solver [--stages 6,12,24] [--solvers dense,mumps,sparse_ldl] "
                "[--dense-max ROWS]\n"
                "                  [--stride K] [--matrices M] [--repeat R] [--csv FILE] "
-               "[--json FILE]\n",
+               "[--json FILE]\n"
+               "                  [--save DIR]\n",
                why.c_str());
   std::exit(exit_code);
 }
@@ -236,6 +242,24 @@ std::pair<double, double> time_both(const Module& m, const std::vector<Matrix>& 
   return {median(ts), median(tm)};
 }
 
+/// The matrices in the binary format of --save.
+void save_matrices(const std::string& path, const std::vector<Matrix>& mats) {
+  std::ofstream os(path, std::ios::binary);
+  const auto put = [&os](const auto* p, std::size_t count) {
+    os.write(reinterpret_cast<const char*>(p), static_cast<std::streamsize>(count * sizeof *p));
+  };
+  const int count = static_cast<int>(mats.size());
+  put(&count, 1);
+  for (const Matrix& m : mats) {
+    put(&m.n, 1);
+    put(&m.nz, 1);
+    put(m.irn.data(), m.irn.size());
+    put(m.icn.data(), m.icn.size());
+    put(m.a.data(), m.a.size());
+  }
+  if (!os) fesd_bench::usage("cannot write " + path, 1);
+}
+
 struct Row {
   int N_stages = 0;
   std::string solver, status;
@@ -258,7 +282,7 @@ int main(int argc, char** argv) {
   std::vector<int> stages{6, 12, 24};
   std::vector<std::string> solvers{"dense", "mumps", "sparse_ldl"};
   int dense_max = 1000, stride = 7, max_matrices = 40, repeat = 5;
-  std::string csv, json_path;
+  std::string csv, json_path, save_dir;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto value = [&]() -> std::string {
@@ -281,6 +305,8 @@ int main(int argc, char** argv) {
       csv = value();
     else if (a == "--json")
       json_path = value();
+    else if (a == "--save")
+      save_dir = value();
     else
       fesd_bench::usage("unknown argument " + a);
   }
@@ -378,6 +404,7 @@ int main(int argc, char** argv) {
       std::erase_if(captured, [&](const Matrix& m) {
         return m.n != n0 || m.nz != nz0 || m.irn != captured.front().irn;
       });
+      if (!save_dir.empty()) save_matrices(save_dir + fmt::format("/kkt_{}.bin", N), captured);
       Direct d;
       d.N_stages = N;
       d.kkt_rows = n0;
