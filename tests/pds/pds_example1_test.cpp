@@ -117,7 +117,9 @@ TEST(PdsExample1OneStage, SwitchesOnBoundariesAndEqualElementsBetween) {
       const bool at_switch = static_cast<int>(n) - 1 == r.switches[0].element ||
                              static_cast<int>(n) - 1 == r.switches[1].element;
       if (!at_switch) {
-        EXPECT_NEAR(r.h[n], r.h[n - 1], 1e-7 * r.h[n]) << "n = " << n;
+        // Equal up to the relaxation's leftovers (measured up to 3.3e-7 relative in a
+        // RelWithDebInfo build; the steps at the switches change by 5e-3 and more).
+        EXPECT_NEAR(r.h[n], r.h[n - 1], 1e-5 * r.h[n]) << "n = " << n;
       }
     }
     for (std::size_t n = 0; n < r.t.size(); ++n)

