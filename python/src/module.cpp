@@ -6,7 +6,6 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
-#include <array>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -447,46 +446,14 @@ py::dict solve(const Problem& problem, const Overrides& overrides) {
   return ocp_dict(p, r);
 }
 
-using Surfaces = std::vector<std::pair<std::string, std::vector<fesd::io_detail::Segment>>>;
-
-Surfaces surfaces_of(const fesd::Pss& model, const Eigen::VectorXd& p, double xlo, double xhi,
-                     double ylo, double yhi, int n_grid) {
-  return fesd::io_detail::switching_surfaces(model, p, xlo, xhi, ylo, yhi, n_grid);
-}
-
-/// A projected model's boundary pieces c_k(x) = 0 (C = {x : c(x) >= 0}).
-Surfaces surfaces_of(const fesd::Pds& model, const Eigen::VectorXd& p, double xlo, double xhi,
-                     double ylo, double yhi, int n_grid) {
-  Surfaces out;
-  if (model.n_x() != 2 || p.size() != model.n_p() || n_grid < 2) return out;
-  const auto n_c = static_cast<std::size_t>(model.n_c());
-  std::vector<Eigen::MatrixXd> values(n_c, Eigen::MatrixXd(n_grid, n_grid));
-  std::vector<double> c(n_c);
-  try {
-    for (int i = 0; i < n_grid; ++i)
-      for (int j = 0; j < n_grid; ++j) {
-        const std::array<double, 2> x{xlo + (xhi - xlo) * i / (n_grid - 1),
-                                      ylo + (yhi - ylo) * j / (n_grid - 1)};
-        model.functions().c(x.data(), p.size() > 0 ? p.data() : nullptr, c.data());
-        for (std::size_t k = 0; k < n_c; ++k) values[k](i, j) = c[k];
-      }
-  } catch (const std::exception&) {
-    return {};  // a function that cannot be evaluated: no surfaces
-  }
-  for (std::size_t k = 0; k < n_c; ++k) {
-    auto seg = fesd::io_detail::zero_contour(values[k], xlo, xhi, ylo, yhi);
-    if (!seg.empty()) out.emplace_back("c[" + std::to_string(k) + "] = 0", std::move(seg));
-  }
-  return out;
-}
-
 /// The switching surfaces of a two-state model in the box [xlo, xhi] x [ylo, yhi], as the
 /// program's phase portrait draws them (a projected model: the boundary of C): (label, (k, 4)
 /// array of segments x0, y0, x1, y1) per surface; empty for other models.
 py::list switching_surfaces(const Problem& problem, double xlo, double xhi, double ylo, double yhi,
                             int n_grid) {
-  const Surfaces surfaces = problem.visit(
-      [&](const auto& q) { return surfaces_of(model_of(q), p_of(q), xlo, xhi, ylo, yhi, n_grid); });
+  const fesd::io_detail::Surfaces surfaces = problem.visit([&](const auto& q) {
+    return fesd::io_detail::switching_surfaces(model_of(q), p_of(q), xlo, xhi, ylo, yhi, n_grid);
+  });
   py::list out;
   for (const auto& [label, segments] : surfaces) {
     py::array_t<double> a({static_cast<py::ssize_t>(segments.size()), py::ssize_t{4}});

@@ -68,8 +68,9 @@ PlotModel::PlotModel(const Pss& model)
       p(model.p_default),
       shaded_name("sliding"),
       shaded([&model](const std::vector<int>& a) { return is_sliding(model, a); }),
-      surfaces([&model](double xlo, double xhi, double ylo, double yhi, int n_grid) {
-        return switching_surfaces(model, model.p_default, xlo, xhi, ylo, yhi, n_grid);
+      surfaces([&model](const Eigen::VectorXd& params, double xlo, double xhi, double ylo,
+                        double yhi, int n_grid) {
+        return switching_surfaces(model, params, xlo, xhi, ylo, yhi, n_grid);
       }) {}
 
 PlotModel::PlotModel(const Pds& model)
@@ -79,30 +80,9 @@ PlotModel::PlotModel(const Pds& model)
       p(model.p_default),
       shaded_name("contact"),
       shaded([](const std::vector<int>& a) { return !a.empty(); }),
-      surfaces([&model](double xlo, double xhi, double ylo, double yhi, int n_grid) {
-        // The boundary pieces c_k(x) = 0 of C = {x : c(x) >= 0}.
-        Surfaces out;
-        const Eigen::VectorXd& pd = model.p_default;
-        if (model.n_x() != 2 || pd.size() != model.n_p() || n_grid < 2) return out;
-        const auto n_c = static_cast<std::size_t>(model.n_c());
-        std::vector<Eigen::MatrixXd> values(n_c, Eigen::MatrixXd(n_grid, n_grid));
-        std::vector<double> c(n_c);
-        try {
-          for (int i = 0; i < n_grid; ++i)
-            for (int j = 0; j < n_grid; ++j) {
-              const std::array<double, 2> x{xlo + (xhi - xlo) * i / (n_grid - 1),
-                                            ylo + (yhi - ylo) * j / (n_grid - 1)};
-              model.functions().c(x.data(), pd.size() > 0 ? pd.data() : nullptr, c.data());
-              for (std::size_t k = 0; k < n_c; ++k) values[k](i, j) = c[k];
-            }
-        } catch (const std::exception&) {
-          return Surfaces{};
-        }
-        for (std::size_t k = 0; k < n_c; ++k) {
-          std::vector<Segment> seg = zero_contour(values[k], xlo, xhi, ylo, yhi);
-          if (!seg.empty()) out.emplace_back(fmt::format("c[{}] = 0", k), std::move(seg));
-        }
-        return out;
+      surfaces([&model](const Eigen::VectorXd& params, double xlo, double xhi, double ylo,
+                        double yhi, int n_grid) {
+        return switching_surfaces(model, params, xlo, xhi, ylo, yhi, n_grid);
       }) {}
 
 // ---- sliding intervals -------------------------------------------------------------------------
@@ -357,6 +337,31 @@ std::vector<std::pair<std::string, std::vector<Segment>>> switching_surfaces(
   return out;
 }
 
+Surfaces switching_surfaces(const Pds& model, const Eigen::VectorXd& p, double xlo, double xhi,
+                            double ylo, double yhi, int n_grid) {
+  Surfaces out;
+  if (model.n_x() != 2 || p.size() != model.n_p() || n_grid < 2) return out;
+  const auto n_c = static_cast<std::size_t>(model.n_c());
+  std::vector<Eigen::MatrixXd> values(n_c, Eigen::MatrixXd(n_grid, n_grid));
+  std::vector<double> c(n_c);
+  try {
+    for (int i = 0; i < n_grid; ++i)
+      for (int j = 0; j < n_grid; ++j) {
+        const std::array<double, 2> x{xlo + (xhi - xlo) * i / (n_grid - 1),
+                                      ylo + (yhi - ylo) * j / (n_grid - 1)};
+        model.functions().c(x.data(), p.size() > 0 ? p.data() : nullptr, c.data());
+        for (std::size_t k = 0; k < n_c; ++k) values[k](i, j) = c[k];
+      }
+  } catch (const std::exception&) {
+    return {};  // a function that cannot be evaluated: no curves, the rest of the plot stays
+  }
+  for (std::size_t k = 0; k < n_c; ++k) {
+    std::vector<Segment> seg = zero_contour(values[k], xlo, xhi, ylo, yhi);
+    if (!seg.empty()) out.emplace_back(fmt::format("c[{}] = 0", k), std::move(seg));
+  }
+  return out;
+}
+
 std::string phase_portrait(const PlotModel& model, const PhaseData& d, double origin_x,
                            double origin_y, double width, double height, int canvas_w,
                            int canvas_h) {
@@ -427,7 +432,7 @@ std::string phase_portrait(const PlotModel& model, const PhaseData& d, double or
   }
   s += "EOD\n";
 
-  const Surfaces surfaces = model.surfaces(xlo, xhi, ylo, yhi, 161);
+  const Surfaces surfaces = model.surfaces(d.p, xlo, xhi, ylo, yhi, 161);
   for (std::size_t i = 0; i < surfaces.size(); ++i) {
     s += fmt::format("$surface{} << EOD\n", i);
     for (const Segment& g : surfaces[i].second)

@@ -59,7 +59,10 @@ struct PlotModel {
   Eigen::VectorXd p;        ///< p_default
   std::string shaded_name;  ///< "sliding" or "contact"
   std::function<bool(const std::vector<int>& active_set)> shaded;
-  std::function<Surfaces(double xlo, double xhi, double ylo, double yhi, int n_grid)> surfaces;
+  /// The curves in a box with parameter values p (switching_surfaces of the model).
+  std::function<Surfaces(const Eigen::VectorXd& p, double xlo, double xhi, double ylo, double yhi,
+                         int n_grid)>
+      surfaces;
 };
 
 // ---- sliding intervals -------------------------------------------------------------------------
@@ -132,6 +135,11 @@ PhaseData phase_data(const OcpResult& r, const PlotModel& model);
 std::vector<std::pair<std::string, std::vector<Segment>>> switching_surfaces(
     const Pss& model, const Eigen::VectorXd& p, double xlo, double xhi, double ylo, double yhi,
     int n_grid = 161);
+
+/// The same for a projected system: the boundary pieces c_k(x) = 0 of C = {x : c(x) >= 0}, one
+/// ("c[k] = 0", segments) pair per constraint that crosses the box.
+Surfaces switching_surfaces(const Pds& model, const Eigen::VectorXd& p, double xlo, double xhi,
+                            double ylo, double yhi, int n_grid = 161);
 
 /// The phase-portrait panel (x2 over x1) in the area at `origin` (x, y) with size (width, height)
 /// in screen units of a canvas_w x canvas_h pixel picture: a square plot at the top of the area:
