@@ -52,7 +52,7 @@ void usage(const std::string& why, int exit_code) {
   std::fprintf(stderr,
                "nosnoc_examples: %s\n"
                "usage: nosnoc_examples [--repeat N] [--fesd PATH] [--examples DIR] "
-               "[--only NAME,...] [--csv FILE] [--json FILE]\n",
+               "[--only NAME,...] [--catalogue] [--csv FILE] [--json FILE]\n",
                why.c_str());
   std::exit(exit_code);
 }
@@ -70,13 +70,13 @@ namespace fs = std::filesystem;
 // objective" columns (/work/shared/NOSNOC-EXAMPLES.md, "Side by side", measured with nosnoc_py
 // 0c3f3bb on CasADi 3.6.3 and Debian's IPOPT 3.11.9 + MUMPS, one process at a time).
 struct Case {
-  const char* name;
-  const char* command;  // simulate or solve
-  const char* file;     // in the examples directory
+  std::string name;
+  std::string command;  // simulate or solve
+  std::string file;     // in the examples directory
   std::vector<std::string> overrides;
   double nosnoc_s;
   double nosnoc_solve_s;
-  const char* nosnoc_result;
+  std::string nosnoc_result;
 };
 
 const std::vector<Case>& cases() {
@@ -102,6 +102,32 @@ const std::vector<Case>& cases() {
       {"sliding_mode_ocp", "solve", "ocp_sliding_mode_nosnoc.toml", {}, 4.9, 4.0, "J = 5.594461"},
   };
   return all;
+}
+
+// --catalogue: every file of DIR/nosnoc/ (issue 17's catalogue of nosnoc_py's examples), `fesd
+// simulate` for a file with a [simulation] table and `fesd solve` otherwise; no nosnoc_py times
+// (NOSNOC-EXAMPLES.md measured only the side-by-side rows), its published values are in
+// docs/nosnoc-examples.md.
+std::vector<Case> catalogue_cases(const std::string& examples) {
+  std::vector<Case> out;
+  std::error_code ec;
+  for (const fs::directory_entry& e : fs::directory_iterator(fs::path(examples) / "nosnoc", ec)) {
+    if (e.path().extension() != ".toml") continue;
+    std::ifstream is(e.path());
+    std::stringstream text;
+    text << is.rdbuf();
+    const bool simulation = text.str().find("\n[simulation]") != std::string::npos;
+    out.push_back({e.path().stem().string(),
+                   simulation ? "simulate" : "solve",
+                   "nosnoc/" + e.path().filename().string(),
+                   {},
+                   NAN,
+                   NAN,
+                   "-"});
+  }
+  if (ec) fesd_bench::usage(fmt::format("{}/nosnoc: {}", examples, ec.message()), 1);
+  std::sort(out.begin(), out.end(), [](const Case& a, const Case& b) { return a.name < b.name; });
+  return out;
 }
 
 struct Run {
@@ -224,6 +250,7 @@ int main(int argc, char** argv) {
   std::string examples = "examples";
 #endif
   std::vector<std::string> only;
+  bool catalogue = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto value = [&]() -> std::string {
@@ -238,6 +265,8 @@ int main(int argc, char** argv) {
       examples = value();
     } else if (a == "--only") {
       only = fesd_bench::split(value(), ',');
+    } else if (a == "--catalogue") {
+      catalogue = true;
     } else if (a == "--csv") {
       csv = value();
     } else if (a == "--json") {
@@ -249,8 +278,8 @@ int main(int argc, char** argv) {
       fesd_bench::usage("unknown argument " + a);
     }
   }
+  const std::vector<Case> all = catalogue ? catalogue_cases(examples) : cases();
   for (const std::string& name : only) {
-    const auto& all = cases();
     if (std::none_of(all.begin(), all.end(), [&](const Case& c) { return name == c.name; }))
       fesd_bench::usage("--only " + name + ": no such case");
   }
@@ -266,7 +295,7 @@ int main(int argc, char** argv) {
              "status", "wall s", "cpu s", "wall s", "nos/fe", "run s", "solve s", "nos/fe",
              "result", "result");
   std::vector<Row> rows;
-  for (const Case& c : cases()) {
+  for (const Case& c : all) {
     if (!only.empty() && std::find(only.begin(), only.end(), c.name) == only.end()) continue;
     Row row;
     row.c = &c;
