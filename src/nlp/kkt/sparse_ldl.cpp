@@ -75,12 +75,15 @@ constexpr double kMaxPivtol = 0.5;
 /// asked for a correction in most solves on OCP (61), for rows whose |A||x| + |b| is itself
 /// round-off, without changing IPOPT's iterates (IPOPT refines on the whole system anyway).
 /// Ruiz sweeps of a factorization whose A still holds the previous factorization's scaling (same
-/// structure): started from it (three from the identity otherwise). Off (kReuseScaling): with it,
-/// the changed round-off made IPOPT's pinned re-solve fail in the homotopy path's co-dimension-2
-/// exit of the periodic stick-slip (PeriodicStickSlipExit.BothContactsSlipWhenX1ReachesOne, in
-/// the sanitizer build's code generation), for about 0.3 M of 4.7 M instructions per
-/// factorization on the nosnoc run.
-constexpr bool kReuseScaling = false;
+/// structure) and that has at least kWarmMinRows rows: kWarmSweeps started from it (three from
+/// the identity otherwise). The two sweeps saved are ~7 % of a factorization's CPU time on OCP
+/// (61) at N_stages 12 and 24. Not below kWarmMinRows: on every size the warm start changed the
+/// round-off, and on the integrator's small NLPs that made IPOPT's pinned re-solve fail in the
+/// homotopy path's co-dimension-2 exit of the periodic stick-slip
+/// (PeriodicStickSlipExit.BothContactsSlipWhenX1ReachesOne, sanitizer build; its KKT matrices
+/// have at most 424 rows, so they keep the three sweeps from the identity, bit for bit).
+constexpr bool kReuseScaling = true;
+constexpr int kWarmMinRows = 1000;
 constexpr int kWarmSweeps = 1;
 constexpr int kMaxRefine = 3;
 constexpr double kBerrTarget = 1e-15;
@@ -1104,8 +1107,9 @@ FESD_KKT_KERNEL void sparse_factor(int n, int nz, const int* irn, const int* icn
   double* scale = a + nz;
   const auto a_addr = reinterpret_cast<std::uintptr_t>(a);
   const int a_lo = static_cast<int>(a_addr & 0x7fffffffU), a_hi = static_cast<int>(a_addr >> 31);
-  const bool warm = kReuseScaling && cached && n >= kKScaleSlots && keep[kKScaled] == 1 &&
-                    keep[kKLa] == la && keep[kKAAddrLo] == a_lo && keep[kKAAddrHi] == a_hi;
+  const bool warm = kReuseScaling && n >= kWarmMinRows && cached && n >= kKScaleSlots &&
+                    keep[kKScaled] == 1 && keep[kKLa] == la && keep[kKAAddrLo] == a_lo &&
+                    keep[kKAAddrHi] == a_hi;
   if (!warm) std::fill_n(scale, n, 1.0);
   Workspace& ws = thread_workspace();
   {
