@@ -237,6 +237,38 @@ TEST(SparseLdl, SameValuesFactorizedAgainGiveTheSameSolution) {
   EXPECT_EQ(solver.solve(b), x1);
 }
 
+// Matrices of at least 1000 rows start their Ruiz sweeps from the previous factorization's
+// scaling (one sweep instead of three from the identity; sparse_ldl.cpp, kWarmMinRows). A
+// symmetric rescaling D K D by powers of ten up to 1e6 (as IPOPT's barrier terms move) starts the
+// second factorization far from its equilibrium: same inertia (congruence), backward error as
+// from the identity; then the first values again.
+TEST(SparseLdl, WarmStartedScalingOnLargeMatrices) {
+  std::mt19937 rng(61);
+  // Regularized (delta_c = 1e-4, H shifted by 3) so that the reference inertia is well defined:
+  // the unregularized random matrices of this size have |eigenvalues| down to 1e-17 of the largest.
+  Triplets t = random_kkt(rng, 700, 500, 1e-4);
+  for (int i = 0; i < 700; ++i) t.add(i, i, 3.0);
+  ASSERT_GE(t.n, 1000);
+  const Eigen::MatrixXd K = t.dense();
+  const Reference ref = reference(K);
+  ASSERT_GT(ref.min_abs_eig, 1e-12 * ref.max_abs_eig);
+  EXPECT_EQ(ref.negative, 500);  // measured: one per constraint
+  std::vector<double> d(static_cast<std::size_t>(t.n));
+  for (double& di : d) di = std::pow(10.0, static_cast<double>(rng() % 7));
+  Triplets scaled = t;
+  for (int e = 0; e < t.nz(); ++e) scaled.val[e] *= d[t.irn[e] - 1] * d[t.icn[e] - 1];
+  const Eigen::MatrixXd K1 = scaled.dense();
+  Ma27 solver(t, FESD_KKT_SPARSE);
+  const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(t.n, -1, 1);
+  const Triplets* const sequence[] = {&t, &scaled, &t};
+  for (const Triplets* values : sequence) {
+    ASSERT_EQ(solver.factor(values->val), 0);
+    EXPECT_EQ(solver.negative(), ref.negative);
+    const Eigen::VectorXd x = solver.solve(b);
+    EXPECT_LT(backward_error(values == &t ? K : K1, x, b), 1e-14);
+  }
+}
+
 long long delayed_pivots() {
   FesdKktStats st{};
   module().stats(&st);

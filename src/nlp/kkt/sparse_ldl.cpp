@@ -75,12 +75,15 @@ constexpr double kMaxPivtol = 0.5;
 /// asked for a correction in most solves on OCP (61), for rows whose |A||x| + |b| is itself
 /// round-off, without changing IPOPT's iterates (IPOPT refines on the whole system anyway).
 /// Ruiz sweeps of a factorization whose A still holds the previous factorization's scaling (same
-/// structure): started from it (three from the identity otherwise). Off (kReuseScaling): with it,
-/// the changed round-off made IPOPT's pinned re-solve fail in the homotopy path's co-dimension-2
-/// exit of the periodic stick-slip (PeriodicStickSlipExit.BothContactsSlipWhenX1ReachesOne, in
-/// the sanitizer build's code generation), for about 0.3 M of 4.7 M instructions per
-/// factorization on the nosnoc run.
-constexpr bool kReuseScaling = false;
+/// structure) and that has at least kWarmMinRows rows: kWarmSweeps started from it (three from
+/// the identity otherwise). The two sweeps saved are ~7 % of a factorization's CPU time on OCP
+/// (61) at N_stages 12 and 24. Not below kWarmMinRows: on every size the warm start changed the
+/// round-off, and on the integrator's small NLPs that made IPOPT's pinned re-solve fail in the
+/// homotopy path's co-dimension-2 exit of the periodic stick-slip
+/// (PeriodicStickSlipExit.BothContactsSlipWhenX1ReachesOne, sanitizer build; its KKT matrices
+/// have at most 424 rows, so they keep the three sweeps from the identity, bit for bit).
+constexpr bool kReuseScaling = true;
+constexpr int kWarmMinRows = 1000;
 constexpr int kWarmSweeps = 1;
 constexpr int kMaxRefine = 3;
 constexpr double kBerrTarget = 1e-15;
@@ -123,9 +126,10 @@ enum KeepSlot {
 /// arrays of ints behind these pointers.
 struct Symbolic {
   const int* iperm;     // n: position of each row in the elimination order
-  const int* colptr;    // n + 1: entries of the permuted lower triangle by column
-  const int* crow;      //   their rows (permuted numbering)
-  const int* slot;      // nz: where triplet e goes in crow (-1: out of range)
+  const int* crow;      // entries: rows (permuted numbering) of the permuted lower triangle
+  const int* qptr;      // ns + 1: each supernode's entries in the factorization's scaled values
+                        //   (own columns in front order, each column's entries as in crow)
+  const int* slot;      // nz: where triplet e goes in them (-1: out of range)
   const int* cols_ptr;  // ns + 1: each supernode's columns ...
   const int* cols;      //   ... in elimination order (permuted numbering)
   const int* sparent;   // ns: parent supernode, -1 at a root
@@ -136,14 +140,16 @@ struct Symbolic {
   // (elimination order), then the others ascending in elimination order ...
   const int* fptr;   // ns + 1
   const int* frows;  //   ... (the delayed pivots of a factorization go between the two parts);
-  const int* amap;   // entries: static front position of crow[p] (column p's own front)
-  const int* eptr;   // clist entries + 1: per child (clist order), the static front positions in
-  const int* emap;   //   its parent of its contribution rows other than delayed pivots
+  // entries (qptr order): the entry's offset in its static front, t ld0 + sp for own column t
+  // and static position sp, ld0 = front_ld(static front size): one flat scatter per front.
+  const int* aoff;
+  const int* eptr;  // clist entries + 1: per child (clist order), the static front positions in
+  const int* emap;  //   its parent of its contribution rows other than delayed pivots
   int ns = 0;
 };
 
 Index symbolic_length(int n, int nz, int entries, int ns, int front_rows, int edge_rows) {
-  return static_cast<Index>(n) * 3 + 1 + entries + nz + 3 * static_cast<Index>(ns) + 2 + ns +
+  return static_cast<Index>(n) * 2 + entries + nz + 4 * static_cast<Index>(ns) + 3 + ns +
          (static_cast<Index>(ns) + 1 + front_rows) + entries + (static_cast<Index>(ns) + edge_rows);
 }
 
@@ -158,10 +164,10 @@ Symbolic symbolic_view(const int* iw) {
   const int* q = iw + iw[kHSymbolic];
   v.iperm = q;
   q += n;
-  v.colptr = q;
-  q += n + 1;
   v.crow = q;
   q += entries;
+  v.qptr = q;
+  q += ns + 1;
   v.slot = q;
   q += nz;
   v.cols_ptr = q;
@@ -178,7 +184,7 @@ Symbolic symbolic_view(const int* iw) {
   q += ns + 1;
   v.frows = q;
   q += iw[kHFrontRows];
-  v.amap = q;
+  v.aoff = q;
   q += entries;
   v.eptr = q;
   q += (ns > 0 ? v.cptr[ns] : 0) + 1;
@@ -988,6 +994,28 @@ Index build_symbolic(int n, int nz, const int* irn, const int* icn, const int* p
     }
   }
   for (int& g : frows) g = perm[g];
+  // The entries in front order (supernodes in order, own columns in front order: one flat
+  // scatter per front in the factorization), with their offsets in the static front; the
+  // triplets' slots follow. The same additions in the same order as column by column.
+  std::vector<int> qptr(static_cast<std::size_t>(ns) + 1, 0), aoff(entries);
+  {
+    std::vector<int> qof(entries);
+    int q = 0;
+    for (int s = 0; s < ns; ++s) {
+      qptr[s] = q;
+      const int ld0 = front_ld(fptr[s + 1] - fptr[s]);
+      for (int t = 0; t < cols_ptr[s + 1] - cols_ptr[s]; ++t) {
+        const int c = cols[cols_ptr[s] + t];
+        for (int p = colptr[c]; p < colptr[c + 1]; ++p) {
+          qof[p] = q;
+          aoff[q++] = t * ld0 + amap[p];
+        }
+      }
+    }
+    qptr[ns] = q;
+    for (int& e : slot)
+      if (e >= 0) e = qof[e];
+  }
 
   const int front_rows = static_cast<int>(frows.size()), edge_rows = static_cast<int>(emap.size());
   const Index need = symbolic_length(n, nz, entries, ns, front_rows, edge_rows);
@@ -998,8 +1026,8 @@ Index build_symbolic(int n, int nz, const int* irn, const int* icn, const int* p
   iw[kHFrontRows] = front_rows;
   iw[kHEdgeRows] = edge_rows;
   int* q = iw + iw_at;
-  for (const std::vector<int>* v : {&iperm, &colptr, &crow, &slot, &cols_ptr, &cols, &sparent,
-                                    &cptr, &clist, &fptr, &frows, &amap, &eptr, &emap})
+  for (const std::vector<int>* v : {&iperm, &crow, &qptr, &slot, &cols_ptr, &cols, &sparent, &cptr,
+                                    &clist, &fptr, &frows, &aoff, &eptr, &emap})
     q = std::copy(v->begin(), v->end(), q);
   return iw_at + need;
 }
@@ -1070,8 +1098,7 @@ FESD_KKT_KERNEL void sparse_factor(int n, int nz, const int* irn, const int* icn
   const Symbolic sym = symbolic_view(iw);
   const Index fixed_liw = iw[kHSymbolic] + symbolic_length(iw);
   iw[kHFirst] = iw[kHEnd] = static_cast<int>(fixed_liw);
-  const int *colptr = sym.colptr, *cols_ptr = sym.cols_ptr, *cols = sym.cols,
-            *sparent = sym.sparent, *cptr = sym.cptr, *clist = sym.clist;
+  const int *cols_ptr = sym.cols_ptr, *sparent = sym.sparent, *cptr = sym.cptr, *clist = sym.clist;
   const int ns = sym.ns;
 
   // Equilibration: S A S with S = scale, three Ruiz sweeps (max-norm of the rows), each factor
@@ -1080,8 +1107,9 @@ FESD_KKT_KERNEL void sparse_factor(int n, int nz, const int* irn, const int* icn
   double* scale = a + nz;
   const auto a_addr = reinterpret_cast<std::uintptr_t>(a);
   const int a_lo = static_cast<int>(a_addr & 0x7fffffffU), a_hi = static_cast<int>(a_addr >> 31);
-  const bool warm = kReuseScaling && cached && n >= kKScaleSlots && keep[kKScaled] == 1 &&
-                    keep[kKLa] == la && keep[kKAAddrLo] == a_lo && keep[kKAAddrHi] == a_hi;
+  const bool warm = kReuseScaling && n >= kWarmMinRows && cached && n >= kKScaleSlots &&
+                    keep[kKScaled] == 1 && keep[kKLa] == la && keep[kKAAddrLo] == a_lo &&
+                    keep[kKAAddrHi] == a_hi;
   if (!warm) std::fill_n(scale, n, 1.0);
   Workspace& ws = thread_workspace();
   {
@@ -1164,7 +1192,6 @@ FESD_KKT_KERNEL void sparse_factor(int n, int nz, const int* irn, const int* icn
   long long delayed = 0;
   bool singular = false;
   for (int s = 0; s < ns; ++s) {
-    const int* own = cols + cols_ptr[s];
     const int nown = cols_ptr[s + 1] - cols_ptr[s];
     const int* srows = sym.frows + sym.fptr[s];
     const int nf0 = sym.fptr[s + 1] - sym.fptr[s];
@@ -1193,14 +1220,17 @@ FESD_KKT_KERNEL void sparse_factor(int n, int nz, const int* irn, const int* icn
     double* fr = front.data();
     zero_front(fr, nf);
     const auto shifted = [nown, nd](int sp) { return sp >= nown ? sp + nd : sp; };
-    for (int t = 0; t < nown; ++t) {
-      const int c = own[t];
-      double* fc = fr + static_cast<std::size_t>(t) * ld;
-      if (nd == 0)
+    // The original entries: one flat scatter over the front's entries (column by column, the
+    // columns hold ~4 entries each, and the per-column loop cost more than the scatter).
+    if (nd == 0) {
 #pragma GCC unroll 4
-        for (int p = colptr[c]; p < colptr[c + 1]; ++p) fc[sym.amap[p]] += cval[p];
-      else
-        for (int p = colptr[c]; p < colptr[c + 1]; ++p) fc[shifted(sym.amap[p])] += cval[p];
+      for (int q = sym.qptr[s]; q < sym.qptr[s + 1]; ++q) fr[sym.aoff[q]] += cval[q];
+    } else {
+      const int ld0 = front_ld(nf0);
+      for (int q = sym.qptr[s]; q < sym.qptr[s + 1]; ++q) {
+        const int t = sym.aoff[q] / ld0, sp = sym.aoff[q] - t * ld0;
+        fr[static_cast<std::size_t>(t) * ld + shifted(sp)] += cval[q];
+      }
     }
     int delayed_at = nown;
     for (int p = cptr[s]; p < cptr[s + 1]; ++p) {
