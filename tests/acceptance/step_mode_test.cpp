@@ -100,6 +100,35 @@ INSTANTIATE_TEST_SUITE_P(
                       Case{"friction_block.toml", {{"T_sim", "1.5"}, {"N_sim", "36"}}, 1e-6, 1e-6}),
     case_name);
 
+// ---- codimension 2: the periodic stick-slip (two switching functions, four regions) ------------
+// Up to t = 2.5 the state slides on x2 = 0.2 (from t = 0.2443) and then, from t = 0.5550, on
+// x2 = 0.2 with x3 > 0.4: regions 1 and 3, a sliding mode of codimension 1 that starts at the
+// codimension-2 point x2 = 0.2, x3 = 0.4. Both forms give the same states at every step end
+// (measured 1.5e-7 to t = 5, the relaxation's level at complementarity_tol 1e-9). The switch lists
+// differ: in Stewart's form the weight theta_0 of region 0 (x2 < 0.2, x3 < 0.4) stays near the
+// activity threshold on that mode and region 0 enters and leaves the active set at every step
+// (20 listed switches to t = 2.6), while theta_0(alpha) = (1 - alpha_1)(1 - alpha_2) is exactly 0
+// once alpha_2 = 1 (x3 > 0.4): the step form lists the two switches only.
+TEST(StepMode, PeriodicStickSlipCodimTwoSameStates) {
+  SimulationProblem p = fesd::load_simulation_problem(example("periodic_stick_slip.toml"));
+  fesd::apply_override(p, "T_sim", "2.5");
+  fesd::apply_override(p, "N_sim", "25");
+  const IntegratorResult a = run(p, "stewart");
+  const IntegratorResult b = run(p, "step");
+  ASSERT_EQ(a.status, fesd::Status::Success) << a.message;
+  ASSERT_EQ(b.status, fesd::Status::Success) << b.message;
+  EXPECT_LE((a.x_final() - b.x_final()).cwiseAbs().maxCoeff(), 1e-6);
+  ASSERT_EQ(b.switches.size(), 2u);
+  EXPECT_EQ(b.switches[0].before, (std::vector<int>{0}));
+  EXPECT_EQ(b.switches[0].after, (std::vector<int>{0, 2}));
+  EXPECT_EQ(b.switches[1].after, (std::vector<int>{1, 3}));
+  ASSERT_GE(a.switches.size(), 2u);
+  EXPECT_NEAR(b.switches[0].t, a.switches[0].t, 1e-6);
+  EXPECT_NEAR(b.switches[1].t, a.switches[1].t, 1e-6);
+  EXPECT_NEAR(b.switches[0].t, 0.244331, 1e-6);
+  EXPECT_NEAR(b.switches[1].t, 0.554993, 1e-6);
+}
+
 // ---- the exact values of REFERENCE.md ----------------------------------------------------------
 
 TEST(StepMode, Example3aCrossingExact) {
@@ -155,6 +184,24 @@ TEST(StepMode, SensitivityOcpSameObjective) {
   EXPECT_NEAR(b.objective, 1.5237727753749571, 1e-6);
   EXPECT_NEAR(b.x0()[0], (9.0 - std::sqrt(417.0)) / 8.0, 1e-5);
   EXPECT_FALSE(b.alpha.empty());
+}
+
+// The sliding-mode OCP (61) with nosnoc_py's settings: two subsystems of one switching function
+// each, so both forms have the same Filippov sets; the same solution (measured: J equal to 1e-10,
+// states at the element boundaries to 1.6e-10, switch times to 3.4e-11).
+TEST(StepMode, SlidingModeOcpSameObjective) {
+  fesd::OcpProblem q = fesd::load_ocp_problem(example("ocp_sliding_mode_nosnoc.toml"));
+  fesd::OcpProblem s = q;
+  fesd::apply_override(s, "dcs_mode", "step");
+  const fesd::OcpResult a = fesd::solve(q.ocp, q.options);
+  const fesd::OcpResult b = fesd::solve(s.ocp, s.options);
+  ASSERT_EQ(a.status, fesd::Status::Success) << a.message;
+  ASSERT_EQ(b.status, fesd::Status::Success) << b.message;
+  EXPECT_NEAR(b.objective, a.objective, 1e-7);
+  EXPECT_NEAR(b.objective, 5.5942052, 1e-6);
+  ASSERT_EQ(a.switches.size(), b.switches.size());
+  for (std::size_t i = 0; i < a.switches.size(); ++i)
+    EXPECT_NEAR(a.switches[i].t, b.switches[i].t, 1e-7) << "switch " << i;
 }
 
 // ---- bad input ---------------------------------------------------------------------------------
