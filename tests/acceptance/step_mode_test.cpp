@@ -9,14 +9,18 @@
 #include <string>
 #include <vector>
 
+#include <fstream>
+
 #include <gtest/gtest.h>
 #include <Eigen/Dense>
+#include <nlohmann/json.hpp>
 
 #include "fesd/error.hpp"
 #include "fesd/integrator.hpp"
 #include "fesd/io.hpp"
 #include "fesd/ocp.hpp"
 #include "fesd/problem_file.hpp"
+#include "support/temp_dir.hpp"
 
 namespace {
 
@@ -202,6 +206,31 @@ TEST(StepMode, SlidingModeOcpSameObjective) {
   ASSERT_EQ(a.switches.size(), b.switches.size());
   for (std::size_t i = 0; i < a.switches.size(); ++i)
     EXPECT_NEAR(a.switches[i].t, b.switches[i].t, 1e-7) << "switch " << i;
+}
+
+// ---- the JSON result: alpha, lambda_p, lambda_n per stage in step mode, absent in Stewart's
+// ------
+
+TEST(StepMode, JsonHasStepValues) {
+  const SimulationProblem p = fesd::load_simulation_problem(example("crossing.toml"));
+  const fesd::testing::TempDir dir("fesd_step_json");
+  const IntegratorResult b = run(p, "step");
+  const IntegratorResult a = run(p, "stewart");
+  ASSERT_EQ(b.status, fesd::Status::Success) << b.message;
+  fesd::write_json(b, p.model, dir.file("step.json"));
+  fesd::write_json(a, p.model, dir.file("stewart.json"));
+  std::ifstream fb(dir.file("step.json")), fa(dir.file("stewart.json"));
+  const nlohmann::json jb = nlohmann::json::parse(fb), ja = nlohmann::json::parse(fa);
+  ASSERT_TRUE(jb.contains("alpha"));
+  EXPECT_EQ(jb["alpha"].size(), jb["theta"].size());
+  EXPECT_EQ(jb["lambda_p"].size(), jb["theta"].size());
+  EXPECT_EQ(jb["lambda_n"].size(), jb["theta"].size());
+  EXPECT_EQ(jb["alpha"][0].size(), 1u);  // n_c = 1
+  // first stage: x < 0, so alpha = 0 and theta = (1 - alpha, alpha) = (1, 0) (S = [[-1], [1]])
+  EXPECT_NEAR(jb["alpha"][0][0].get<double>(), 0.0, 1e-6);
+  EXPECT_NEAR(jb["theta"][0][0].get<double>(), 1.0, 1e-6);
+  EXPECT_NEAR(jb["lambda_p"][0][0].get<double>(), 0.0, 1e-8);
+  EXPECT_FALSE(ja.contains("alpha"));
 }
 
 // ---- bad input ---------------------------------------------------------------------------------
