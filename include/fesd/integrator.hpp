@@ -86,7 +86,13 @@ struct IntegratorResult {
 
   /// Stage points t_n + c_m h_n and the stage values there (size N_sim * N_FE * n_s each).
   std::vector<double> t_stage;
+  /// theta: the region weights (Stewart), theta(alpha) in the step form (dcs_mode = step).
+  /// lambda: Stewart's lambda; in the step form per region sum_j (S_rj = +1 ? lambda_n_j :
+  /// lambda_p_j), zero exactly in the closure of the region. mu: Stewart only (empty rows else).
   std::vector<Eigen::VectorXd> x_stage, theta, lambda, mu;
+  /// The step form's stage values (dcs_mode = step, else empty): alpha, lambda_p, lambda_n per
+  /// switching function (n_c each), at the same stage points.
+  std::vector<Eigen::VectorXd> alpha, lambda_p, lambda_n;
 
   /// Active regions per element (global region indices, sorted), size N_sim * N_FE.
   std::vector<std::vector<int>> active_set;

@@ -176,6 +176,9 @@ struct OcpResult {
   std::vector<double> t_stage;           ///< stage times
   std::vector<Eigen::VectorXd> x_stage;  ///< stage states
   std::vector<Eigen::VectorXd> theta, lambda;
+  /// The step form's stage values (dcs_mode = step, else empty): alpha, lambda_p, lambda_n (n_c
+  /// each); theta is then theta(alpha), lambda per region as in IntegratorResult.
+  std::vector<Eigen::VectorXd> alpha, lambda_p, lambda_n;
 
   std::vector<HomotopyRow> homotopy;  ///< one row per NLP (a pinned re-solve last)
   Summary summary;                    ///< work and time; n_variables, n_constraints: the NLP

@@ -71,6 +71,20 @@ enum class StageLambdaSign {
 std::string_view to_string(StageLambdaSign v);
 bool parse(std::string_view name, StageLambdaSign& out);
 
+/// How the set-valued sign functions of c-form subsystems enter the complementarity system.
+enum class DcsMode {
+  /// Stewart's DCS (8)/(21): theta per region, the LP (7) with multipliers lambda, mu.
+  Stewart,
+  /// The Heaviside step form (nosnoc's DcsMode.Step): alpha in [0, 1] per switching function
+  /// with multipliers lambda_p, lambda_n, c(x) = lambda_p - lambda_n, and the region weights
+  /// theta_i = prod_j (alpha_j or 1 - alpha_j) (docs/formulation.md, "Heaviside step form").
+  /// c-form subsystems only.
+  Step,
+};
+/// Problem-file key `dcs_mode`: "stewart", "step" (and nosnoc's spellings Stewart, Step).
+std::string_view to_string(DcsMode v);
+bool parse(std::string_view name, DcsMode& out);
+
 /// Discretization of one interval [0, T] (problem-file table [discretization]).
 struct DiscretizationOptions {
   RkScheme rk_scheme = RkScheme::RadauIIA;  ///< `rk_scheme`
@@ -90,6 +104,8 @@ struct DiscretizationOptions {
   /// its sliding mode up to 0.17 early without it, to 7e-9 with it; Fig. 13's E(T) of Radau IIA
   /// n_s = 3, N_FE = 3 falls from 3.9e-8 to 3.3e-9 (the reference simulation's exit was early).
   bool pin_sliding_exits = true;
+  /// `dcs_mode`: Stewart's form (default) or the Heaviside step form (c-form subsystems only).
+  DcsMode dcs_mode = DcsMode::Stewart;
 };
 
 /// How the complementarity constraints of the MPCC are relaxed, smoothed or penalized in the

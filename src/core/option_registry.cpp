@@ -285,6 +285,10 @@ std::vector<Option> build() {
       kDisc, "rho_h", kBoth,
       "weight of the step-equilibration penalty (heuristic_mean, heuristic_delta, l2_relaxed)",
       "rho_h", kPositive));
+  o.push_back(scalar<&T::discretization, &D::dcs_mode>(
+      kDisc, "dcs_mode", kBoth,
+      "stewart: theta per region (8); step: alpha per switching function (Heaviside step form)",
+      "dcs_mode"));
   o.push_back(scalar<&T::discretization, &D::pin_sliding_exits>(
       kDisc, "pin_sliding_exits", kBoth,
       "solve once more with sliding exits pinned where theta has not reached 0", ""));

@@ -110,6 +110,8 @@ std::span<const std::string_view> enum_names<StepEq>();
 template <>
 std::span<const std::string_view> enum_names<StageLambdaSign>();
 template <>
+std::span<const std::string_view> enum_names<DcsMode>();
+template <>
 std::span<const std::string_view> enum_names<MpccMode>();
 template <>
 std::span<const std::string_view> enum_names<TerminalConstraint>();

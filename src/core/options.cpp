@@ -30,6 +30,7 @@ constexpr std::array<std::string_view, 2> kTerminalConstraint{"none", "ell_1"};
 constexpr std::array<std::string_view, 3> kOcpInitialization{"constant", "simulation", "external"};
 constexpr std::array<std::string_view, 4> kKktSolver{"auto", "sparse_ldl", "dense", "mumps"};
 constexpr std::array<std::string_view, 2> kStepSolver{"homotopy", "active_set"};
+constexpr std::array<std::string_view, 2> kDcsMode{"stewart", "step"};
 
 template <class E, std::size_t K>
 std::string_view name_of(const std::array<std::string_view, K>& names, E v) {
@@ -91,7 +92,21 @@ template <>
 std::span<const std::string_view> enum_names<StepSolver>() {
   return kStepSolver;
 }
+template <>
+std::span<const std::string_view> enum_names<DcsMode>() {
+  return kDcsMode;
+}
 }  // namespace registry
+
+std::string_view to_string(DcsMode v) {
+  return name_of(kDcsMode, v);
+}
+bool parse(std::string_view name, DcsMode& out) {
+  // nosnoc's spellings (DcsMode.Stewart, DcsMode.Step) too.
+  if (name == "Stewart") name = "stewart";
+  if (name == "Step") name = "step";
+  return parse_from(kDcsMode, name, out);
+}
 
 std::string_view to_string(RkScheme v) {
   return name_of(kRkScheme, v);

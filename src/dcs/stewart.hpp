@@ -82,6 +82,9 @@ inline std::vector<int> region_subsystem(const Pss& m) {
 /// theta^k spread equally over the minimizers (one valid choice, e.g. lambda_{0,0}, mu_{0,0}).
 struct LpSolution {
   Eigen::VectorXd g, lambda, mu, theta;
+  /// The Heaviside step form only (dcs/step.hpp): alpha per switching function (n_c); lambda
+  /// then holds (lambda_n, lambda_p) and mu is empty.
+  Eigen::VectorXd alpha;
 };
 LpSolution solve_lp(const Pss& m, const Eigen::VectorXd& x, const Eigen::VectorXd& p,
                     double tie_tol = 1e-12);

@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include "dcs/step.hpp"
 #include "discretization/dynamics_block.hpp"
 #include "discretization/stage_state_block.hpp"
 #include "discretization/step_equilibration_block.hpp"
@@ -81,6 +82,47 @@ struct SimplexEq {
   }
 };
 
+/// The step form's c(X) - lambda_p + lambda_n = 0.  inputs: X (n_x), lambda_n (n_c),
+/// lambda_p (n_c), p
+struct StepCEq {
+  const Pss* m;
+  int num_inputs() const { return m->n_x() + 2 * m->n_c() + m->n_p(); }
+  int num_outputs() const { return m->n_c(); }
+  template <class T>
+  void operator()(const T* w, T* c) const {
+    const int n_c = m->n_c();
+    const T* X = w;
+    const T* ln = X + m->n_x();
+    const T* lp = ln + n_c;
+    const T* p = lp + n_c;
+    m->functions().c(X, p, c);
+    for (int j = 0; j < n_c; ++j) c[j] = c[j] - lp[j] + ln[j];
+  }
+};
+
+/// The step form's theta - theta(alpha) = 0.  inputs: theta (n_theta), alpha (n_c)
+struct StepThetaEq {
+  const Pss* m;
+  int num_inputs() const { return m->n_theta() + m->n_c(); }
+  int num_outputs() const { return m->n_theta(); }
+  template <class T>
+  void operator()(const T* w, T* c) const {
+    dcs::eval_theta_of_alpha(*m, w + m->n_theta(), c);
+    for (int r = 0; r < m->n_theta(); ++r) c[r] = w[r] - c[r];
+  }
+};
+
+/// alpha_j + beta_j = 1 (beta = 1 - alpha as a variable).  inputs: alpha (n_c), beta (n_c)
+struct AlphaBetaEq {
+  int n_c;
+  int num_inputs() const { return 2 * n_c; }
+  int num_outputs() const { return n_c; }
+  template <class T>
+  void operator()(const T* w, T* c) const {
+    for (int j = 0; j < n_c; ++j) c[j] = w[j] + w[n_c + j];
+  }
+};
+
 /// (h - h0)^2, the heuristic_mean penalty term.
 struct SquaredDeviation {
   double h0;
@@ -110,6 +152,10 @@ FesdInterval::FesdInterval(const Pss& model, const Tableau& tableau,
                            const DiscretizationOptions& options)
     : model_(model), tab_(tableau), opt_(options), N_FE_(options.N_FE), n_s_(tableau.n_s) {
   stiffly_accurate_ = tab_.stiffly_accurate;
+  step_ = options.dcs_mode == DcsMode::Step;
+  n_lam_ = dcs::n_lambda(model, options.dcs_mode);
+  n_mu_ = dcs::n_mu(model, options.dcs_mode);
+  owner_ = dcs::region_subsystem(model);
   const StageLambdaSign sign = options.stage_lambda_sign;
   boundary_sign_ =
       options.use_fesd && (sign == StageLambdaSign::Boundary ||
@@ -120,6 +166,8 @@ FesdInterval::FesdInterval(const Pss& model, const Tableau& tableau,
 std::vector<std::string> FesdInterval::block_size_errors(const Pss& m,
                                                          const DiscretizationOptions& options) {
   std::vector<std::string> errors;
+  if (options.dcs_mode == DcsMode::Step)
+    if (std::string e = dcs::step_mode_error(m); !e.empty()) return {e};
   const int limit = ad::kMaxInputs;
   const int n_x = m.n_x(), n_th = m.n_theta();
   // The model's blocks, as build() creates them (the same functors, so the counts cannot drift).
@@ -151,7 +199,8 @@ std::vector<std::string> FesdInterval::block_size_errors(const Pss& m,
   const StepEq se = options.step_eq;
   if (options.use_fesd && options.N_FE >= 2 &&
       (se == StepEq::Eta || se == StepEq::EtaTanh || se == StepEq::L2Relaxed)) {
-    const int step_eq = 2 + 4 * n_th;  // h_{n-1}, h_n and 4 lifted sums per region
+    // h_{n-1}, h_n and 4 lifted sums per region (step form: per entry of (alpha, beta))
+    const int step_eq = 2 + 4 * (options.dcs_mode == DcsMode::Step ? 2 * m.n_c() : n_th);
     if (step_eq > limit)
       errors.push_back(fmt::format(
           "discretization.step_equilibration = {}: the step equilibration (31) of two neighbouring "
@@ -166,11 +215,12 @@ std::vector<std::string> FesdInterval::block_size_errors(const Pss& m,
 void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
   in_ = in;
   const Pss& m = model_;
-  const int n_x = m.n_x(), n_th = m.n_theta(), n_sys = m.n_sys();
+  const int n_x = m.n_x(), n_th = m.n_theta(), n_sys = m.n_sys(), n_c = m.n_c();
+  const int n_lam = n_lam_, n_mu = n_mu_, n_cp = n_comp();
   if (static_cast<int>(in.s0.size()) != n_x || static_cast<int>(in.q.size()) != m.n_u() ||
       static_cast<int>(in.p.size()) != m.n_p() ||
-      static_cast<int>(in.lambda_start.size()) != n_th ||
-      static_cast<int>(in.mu_start.size()) != n_sys)
+      static_cast<int>(in.lambda_start.size()) != n_lam_ ||
+      static_cast<int>(in.mu_start.size()) != n_mu_)
     throw InternalError("internal: FesdInterval inputs do not match the model dimensions");
   const bool fesd = opt_.use_fesd;
   const double h0 = in.T / N_FE_;
@@ -182,6 +232,7 @@ void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
   theta_.assign(N_FE_ * n_s_, -1);
   lambda_.assign(N_FE_ * n_s_, -1);
   mu_.assign(N_FE_ * n_s_, -1);
+  alpha_.assign(N_FE_ * n_s_, -1);
   x_.assign(N_FE_ + 1, {});
   x_[0] = in.s0;
   lambda_end_.assign(N_FE_, {});
@@ -195,17 +246,20 @@ void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
     for (int s = 0; s < n_s_; ++s) {
       V_[idx(n, s)] = nlp.add_variables(n_x, -kInf, kInf, 0.0);
       X_[idx(n, s)] = nlp.add_variables(n_x, -kInf, kInf, 0.0);
-      theta_[idx(n, s)] = nlp.add_variables(n_th, 0.0, kInf, 0.0);
+      // (step form: theta = theta(alpha) is a lifted variable, alpha and beta = 1 - alpha in
+      // [0, 1] the complementarity variables)
+      theta_[idx(n, s)] = nlp.add_variables(n_th, step_ ? -kInf : 0.0, kInf, 0.0);
+      if (step_) alpha_[idx(n, s)] = nlp.add_variables(2 * n_c, 0.0, 1.0, 0.5);
       // Boundary sign: lambda >= 0 only where the stage is the element's end point.
       stage_signed_[idx(n, s)] = !boundary_sign_ || (stiffly_accurate_ && s == n_s_ - 1);
       lambda_[idx(n, s)] =
-          nlp.add_variables(n_th, stage_signed_[idx(n, s)] ? 0.0 : -kInf, kInf, 0.0);
-      mu_[idx(n, s)] = nlp.add_variables(n_sys, -kInf, kInf, 0.0);
+          nlp.add_variables(n_lam, stage_signed_[idx(n, s)] ? 0.0 : -kInf, kInf, 0.0);
+      mu_[idx(n, s)] = nlp.add_variables(n_mu, -kInf, kInf, 0.0);
     }
     if (stiffly_accurate_) {
       x_[n + 1] = range(X_[idx(n, n_s_ - 1)], n_x);  // x_{n+1} = X_{n,n_s}: last row of A is b
-      lambda_end_[n] = range(lambda_[idx(n, n_s_ - 1)], n_th);
-      mu_end_[n] = range(mu_[idx(n, n_s_ - 1)], n_sys);
+      lambda_end_[n] = range(lambda_[idx(n, n_s_ - 1)], n_lam);
+      mu_end_[n] = range(mu_[idx(n, n_s_ - 1)], n_mu);
     } else {
       x_[n + 1] = range(nlp.add_variables(n_x, -kInf, kInf, 0.0), n_x);
       // With free stage lambdas every element end needs its signed boundary point.
@@ -213,8 +267,8 @@ void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
       if (boundary) {
         boundary_vars_[n] =
             true;  // (33): lambda, mu at t_{n+1} from LP(x_{n+1}); theta discarded (39)
-        lambda_end_[n] = range(nlp.add_variables(n_th, 0.0, kInf, 0.0), n_th);
-        mu_end_[n] = range(nlp.add_variables(n_sys, -kInf, kInf, 0.0), n_sys);
+        lambda_end_[n] = range(nlp.add_variables(n_lam, 0.0, kInf, 0.0), n_lam);
+        mu_end_[n] = range(nlp.add_variables(n_mu, -kInf, kInf, 0.0), n_mu);
       }
     }
   }
@@ -224,7 +278,11 @@ void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
   std::vector<int> offsets;
   for (int k = 0; k <= n_sys; ++k) offsets.push_back(m.region_offset(k));
   const std::shared_ptr<const nlp::Block> dynamics = std::make_shared<DynamicsBlock>(m);
-  auto lp = make_block(LpEq{&m, owner});
+  // The multiplier equation of a point: Stewart's LP (9), or the step form's c = lambda_p -
+  // lambda_n; inputs X, lambda (n_lam), mu (n_mu), p either way.
+  auto lp = step_ ? make_block(StepCEq{&m}) : make_block(LpEq{&m, owner});
+  auto theta_of_alpha = make_block(StepThetaEq{&m});
+  auto alpha_beta = make_block(AlphaBetaEq{n_c});
   auto simplex = make_block(SimplexEq{offsets});
   std::vector<std::shared_ptr<const nlp::Block>> stage_state(n_s_);
   std::vector<std::vector<int>> stage_cols(n_s_);
@@ -261,11 +319,18 @@ void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
       dv.insert(dv.end(), in.p.begin(), in.p.end());
       nlp.add_constraint(dynamics, dv, 0.0, 0.0);
       std::vector<int> lv = range(X(n, s, 0), n_x);  // (9): g(X) - lambda - mu e = 0
-      for (int r = 0; r < n_th; ++r) lv.push_back(lambda(n, s, r));
-      for (int k = 0; k < n_sys; ++k) lv.push_back(mu(n, s, k));
+      for (int r = 0; r < n_lam; ++r) lv.push_back(lambda(n, s, r));
+      for (int k = 0; k < n_mu; ++k) lv.push_back(mu(n, s, k));
       lv.insert(lv.end(), in.p.begin(), in.p.end());
       nlp.add_constraint(lp, lv, 0.0, 0.0);
-      nlp.add_constraint(simplex, range(theta(n, s, 0), n_th), 1.0, 1.0);  // e' theta = 1
+      if (step_) {  // theta = theta(alpha), alpha + beta = 1
+        std::vector<int> tv = range(theta(n, s, 0), n_th);
+        for (int j = 0; j < n_c; ++j) tv.push_back(alpha(n, s, j));
+        nlp.add_constraint(theta_of_alpha, tv, 0.0, 0.0);
+        nlp.add_constraint(alpha_beta, range(alpha(n, s, 0), 2 * n_c), 1.0, 1.0);
+      } else {
+        nlp.add_constraint(simplex, range(theta(n, s, 0), n_th), 1.0, 1.0);  // e' theta = 1
+      }
     }
     if (!stiffly_accurate_) {
       for (int i = 0; i < n_x; ++i) {  // x_{n+1} = x_n + h_n sum b_m V_{n,m}
@@ -301,7 +366,7 @@ void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
       point_signed_[n].push_back(true);
     }
     for (int s = 0; s < n_s_; ++s) {
-      points_[n].push_back(range(lambda(n, s, 0), n_th));
+      points_[n].push_back(range(lambda(n, s, 0), n_lam));
       point_signed_[n].push_back(stage_signed_[idx(n, s)]);
     }
     if (boundary_vars_[n]) {
@@ -316,10 +381,11 @@ void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
     if (opt_.step_eq == StepEq::Eta || opt_.step_eq == StepEq::EtaTanh ||
         opt_.step_eq == StepEq::L2Relaxed) {
       // Lifted per-element sums: sigma^lambda_{n,r} over the signed points, sigma^theta_{n,r}
-      // over the stages. Each (31) block then has 2 + 4 n_theta inputs instead of
-      // 2 + n_theta (2 (n_s + 2) + 2 n_s) (docs/derivatives.md).
-      lam_sum_.assign(N_FE_, std::vector<int>(n_th, -1));
-      th_sum_.assign(N_FE_, std::vector<int>(n_th, -1));
+      // over the stages (step form: r over the entries of (lambda_n, lambda_p) and of
+      // (alpha, beta), docs/formulation.md). Each (31) block then has 2 + 4 n_theta inputs instead
+      // of 2 + n_theta (2 (n_s + 2) + 2 n_s) (docs/derivatives.md).
+      lam_sum_.assign(N_FE_, std::vector<int>(n_cp, -1));
+      th_sum_.assign(N_FE_, std::vector<int>(n_cp, -1));
       std::map<int, std::shared_ptr<const nlp::Block>> sum_blocks;
       auto sum_block = [&](int k) {
         auto& block = sum_blocks[k];
@@ -327,7 +393,7 @@ void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
         return block;
       };
       for (int n = 0; n < N_FE_; ++n)
-        for (int r = 0; r < n_th; ++r) {
+        for (int r = 0; r < n_cp; ++r) {
           lam_sum_[n][r] = nlp.add_variables(1, -kInf, kInf, 0.0);
           std::vector<int> lv{lam_sum_[n][r]};
           for (std::size_t q = 0; q < points_[n].size(); ++q)
@@ -335,7 +401,7 @@ void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
           nlp.add_constraint(sum_block(static_cast<int>(lv.size())), lv, 0.0, 0.0);
           th_sum_[n][r] = nlp.add_variables(1, -kInf, kInf, 0.0);
           std::vector<int> tv{th_sum_[n][r]};
-          for (int st = 0; st < n_s_; ++st) tv.push_back(theta(n, st, r));
+          for (int st = 0; st < n_s_; ++st) tv.push_back(comp_var(n, st, r));
           nlp.add_constraint(sum_block(static_cast<int>(tv.size())), tv, 0.0, 0.0);
         }
       for (int n = 1; n < N_FE_; ++n) {  // (31)
@@ -346,11 +412,11 @@ void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
         f.h_scale = h0;
         f.h_prev = vl.add(h(n - 1));
         f.h_cur = vl.add(h(n));
-        f.lam_B.assign(n_th, {});
-        f.lam_F.assign(n_th, {});
-        f.th_B.assign(n_th, {});
-        f.th_F.assign(n_th, {});
-        for (int r = 0; r < n_th; ++r) {
+        f.lam_B.assign(n_cp, {});
+        f.lam_F.assign(n_cp, {});
+        f.th_B.assign(n_cp, {});
+        f.th_F.assign(n_cp, {});
+        for (int r = 0; r < n_cp; ++r) {
           f.lam_B[r].push_back(vl.add(lam_sum_[n - 1][r]));
           f.lam_F[r].push_back(vl.add(lam_sum_[n][r]));
           f.th_B[r].push_back(vl.add(th_sum_[n - 1][r]));
@@ -376,7 +442,9 @@ void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
 }
 
 void FesdInterval::build_complementarity() {
-  const int n_th = model_.n_theta();
+  // Pairs (theta_r, lambda_r), or in the step form (alpha_j, lambda_n_j) and (beta_j,
+  // lambda_p_j): comp_var(n, s, i) with the entry i of a multiplier point.
+  const int n_th = n_comp();
   residual_pairs_.clear();
   groups_.clear();
   const bool fesd = opt_.use_fesd;
@@ -395,7 +463,7 @@ void FesdInterval::build_complementarity() {
         CompGroup stage_sum;
         for (int q = 0; q < static_cast<int>(pts.size()); ++q) {
           if (!fesd && q != own) continue;  // standard method: no cross complementarity
-          const CompPair pair{theta(n, s, r), pts[q][r]};
+          const CompPair pair{comp_var(n, s, r), pts[q][r]};
           if (!point_signed_[n][q]) {  // free lambda: only its own stage's product, two-sided
             if (q == own) {
               residual_pairs_.push_back(pair);
@@ -431,7 +499,7 @@ void FesdInterval::build_complementarity() {
 
 void FesdInterval::set_guess(std::vector<double>& w, const Eigen::VectorXd& x0,
                              const dcs::LpSolution& lp, const Eigen::VectorXd& xdot) const {
-  const int n_x = model_.n_x(), n_th = model_.n_theta(), n_sys = model_.n_sys();
+  const int n_x = model_.n_x(), n_th = model_.n_theta(), n_sys = n_mu_, n_c = model_.n_c();
   const double h0 = in_.T / N_FE_;
   for (int n = 0; n <= N_FE_; ++n)
     for (int i = 0; i < n_x; ++i) w[x(n, i)] = x0[i] + n * h0 * xdot[i];
@@ -442,14 +510,17 @@ void FesdInterval::set_guess(std::vector<double>& w, const Eigen::VectorXd& x0,
         w[V(n, s, i)] = xdot[i];
         w[X(n, s, i)] = x0[i] + (n + tab_.c(s)) * h0 * xdot[i];
       }
-      for (int r = 0; r < n_th; ++r) {
-        w[theta(n, s, r)] = lp.theta[r];
-        w[lambda(n, s, r)] = lp.lambda[r];
-      }
+      for (int r = 0; r < n_th; ++r) w[theta(n, s, r)] = lp.theta[r];
+      for (int r = 0; r < n_lam_; ++r) w[lambda(n, s, r)] = lp.lambda[r];
       for (int k = 0; k < n_sys; ++k) w[mu(n, s, k)] = lp.mu[k];
+      if (step_)
+        for (int j = 0; j < n_c; ++j) {
+          w[alpha(n, s, j)] = lp.alpha[j];
+          w[alpha(n, s, n_c + j)] = 1.0 - lp.alpha[j];
+        }
     }
     if (boundary_vars_[n]) {
-      for (int r = 0; r < n_th; ++r) w[lambda_end_[n][r]] = lp.lambda[r];
+      for (int r = 0; r < n_lam_; ++r) w[lambda_end_[n][r]] = lp.lambda[r];
       for (int k = 0; k < n_sys; ++k) w[mu_end_[n][k]] = lp.mu[k];
     }
   }
@@ -466,7 +537,7 @@ bool theta_outweighs(double theta_sum, double abs_lambda_sum, double theta_max) 
 
 bool FesdInterval::stage_active(const double* w, int n, int m, int r) const {
   const double th = w[theta(n, m, r)];
-  return theta_outweighs(th, std::abs(w[lambda(n, m, r)]), th);
+  return theta_outweighs(th, std::abs(region_lambda(w, n, m, r)), th);
 }
 
 std::vector<int> FesdInterval::active_set(const double* w, int n) const {
@@ -482,10 +553,18 @@ void FesdInterval::active_set(const double* w, int n, std::vector<int>& active) 
     for (int s = 0; s < n_s_; ++s) {
       th += w[theta(n, s, r)];
       th_max = std::max(th_max, w[theta(n, s, r)]);
-      la += std::abs(w[lambda(n, s, r)]);
+      la += std::abs(region_lambda(w, n, s, r));
     }
     if (theta_outweighs(th, la, th_max)) active.push_back(r);
   }
+}
+
+double FesdInterval::region_lambda(const double* w, int n, int m, int r) const {
+  if (!step_) return w[lambda(n, m, r)];
+  thread_local std::vector<double> mult;
+  mult.resize(static_cast<std::size_t>(n_lam_));
+  for (int i = 0; i < n_lam_; ++i) mult[i] = w[lambda(n, m, i)];
+  return dcs::region_multiplier(model_, owner_, r, mult.data());
 }
 
 std::vector<std::vector<int>> FesdInterval::active_sets(const double* w) const {
@@ -581,6 +660,7 @@ std::vector<nlp::Bound> FesdInterval::active_set_bounds(
     return false;
   };
   std::vector<nlp::Bound> bounds;
+  if (step_) return step_active_set_bounds(active);
   for (int n = 0; n < N_FE_; ++n)
     for (int r = 0; r < model_.n_theta(); ++r) {
       // theta = 0 off the active set; lambda = 0 on it at every point of the element: its start
@@ -601,20 +681,63 @@ std::vector<nlp::Bound> FesdInterval::active_set_bounds(
   return bounds;
 }
 
+std::vector<nlp::Bound> FesdInterval::step_active_set_bounds(
+    const std::vector<std::vector<int>>& active) const {
+  // Per element and switching function j, the signs S_rj of its active regions: only +1 (the
+  // element lies in c_j >= 0): alpha_j = 1 at the stages, lambda_n_j = 0 at every point of the
+  // element; only -1: alpha_j = 0, lambda_p_j = 0; both (sliding on c_j = 0): lambda_n_j =
+  // lambda_p_j = 0 at every point, alpha_j free. At the start point of a sliding j (lp_at_start)
+  // lambda_n_j stays free of its sign bound instead (as active_set_bounds() keeps one lambda of
+  // Stewart's form): c_j(s0) = lambda_p_j - lambda_n_j with both fixed would repeat c_j(s0) = 0.
+  const int n_c = model_.n_c();
+  std::vector<nlp::Bound> bounds;
+  for (int n = 0; n < N_FE_; ++n) {
+    int c_off = 0;
+    for (int k = 0; k < model_.n_sys(); ++k) {
+      const Eigen::MatrixXd& S = model_.S(k);
+      const int r0 = model_.region_offset(k), r1 = model_.region_offset(k + 1);
+      for (int j = 0; j < model_.dims().subsystems[k].n_c; ++j) {
+        const int jj = c_off + j;
+        bool plus = false, minus = false;
+        for (int r = r0; r < r1; ++r)
+          if (has(active[n], r)) (S(r - r0, j) > 0 ? plus : minus) = true;
+        if (!plus && !minus) continue;
+        auto fix_points = [&](int i) {  // multiplier entry i = 0 at every point of element n
+          for (std::size_t q = 0; q < points_[n].size(); ++q) {
+            if (n == 0 && q == 0 && in_.lp_at_start && plus && minus && i == jj)
+              bounds.push_back({points_[n][q][i], -nlp::kInf, nlp::kInf});
+            else
+              bounds.push_back({points_[n][q][i], 0.0, 0.0});
+          }
+        };
+        if (plus) fix_points(jj);         // lambda_n_j = 0
+        if (minus) fix_points(n_c + jj);  // lambda_p_j = 0
+        if (plus != minus)
+          for (int s = 0; s < n_s_; ++s) {
+            bounds.push_back({alpha(n, s, jj), plus ? 1.0 : 0.0, plus ? 1.0 : 0.0});
+            bounds.push_back({alpha(n, s, n_c + jj), plus ? 0.0 : 1.0, plus ? 0.0 : 1.0});
+          }
+      }
+      c_off += model_.dims().subsystems[k].n_c;
+    }
+  }
+  return bounds;
+}
+
 void FesdInterval::update_lifted_guess(std::vector<double>& w) const {
   for (std::size_t n = 0; n < lam_sum_.size(); ++n)
     for (std::size_t r = 0; r < lam_sum_[n].size(); ++r) {
       double sl = 0, st = 0;
       for (std::size_t q = 0; q < points_[n].size(); ++q)
         if (point_signed_[n][q]) sl += w[points_[n][q][r]];
-      for (int s = 0; s < n_s_; ++s) st += w[theta(static_cast<int>(n), s, static_cast<int>(r))];
+      for (int s = 0; s < n_s_; ++s) st += w[comp_var(static_cast<int>(n), s, static_cast<int>(r))];
       w[lam_sum_[n][r]] = sl;
       w[th_sum_[n][r]] = st;
     }
 }
 
 std::vector<double> FesdInterval::eta(const double* w) const {
-  const int n_th = model_.n_theta();
+  const int n_th = n_comp();
   std::vector<double> out(N_FE_, std::numeric_limits<double>::quiet_NaN());
   for (int n = 1; n < N_FE_; ++n) {
     double e = 1.0;
@@ -625,8 +748,8 @@ std::vector<double> FesdInterval::eta(const double* w) const {
       for (std::size_t q = 0; q < points_[n].size(); ++q)
         if (point_signed_[n][q]) lf += w[points_[n][q][r]];
       for (int s = 0; s < n_s_; ++s) {
-        tb += w[theta(n - 1, s, r)];
-        tf += w[theta(n, s, r)];
+        tb += w[comp_var(n - 1, s, r)];
+        tf += w[comp_var(n, s, r)];
       }
       e *= lb * lf + tb * tf;
     }

@@ -93,6 +93,23 @@ class FesdInterval {
   int theta(int n, int m, int r) const { return theta_[idx(n, m)] + r; }
   int lambda(int n, int m, int r) const { return lambda_[idx(n, m)] + r; }
   int mu(int n, int m, int k) const { return mu_[idx(n, m)] + k; }
+  // ---- the Heaviside step form (DiscretizationOptions::dcs_mode = step; dcs/step.hpp) ----
+  // theta(n, m, r) is then theta(alpha) (a lifted variable), lambda(n, m, i) the multipliers
+  // (lambda_n (i < n_c), lambda_p (i = n_c + j)), mu has no entries, and alpha(n, m, i) is alpha_j
+  // (i = j < n_c) or beta_j = 1 - alpha_j (i = n_c + j).
+  bool step_mode() const { return step_; }
+  /// Multipliers per point: n_theta (Stewart), 2 n_c (step).
+  int n_lambda() const { return n_lam_; }
+  /// mu per point: n_sys (Stewart), 0 (step).
+  int n_mu() const { return n_mu_; }
+  int alpha(int n, int m, int i) const { return alpha_[idx(n, m)] + i; }
+  /// The complementarity variables of a stage: theta (Stewart), (alpha, beta) (step); entry i
+  /// pairs with entry i of each multiplier point.
+  int n_comp() const { return step_ ? 2 * model_.n_c() : model_.n_theta(); }
+  int comp_var(int n, int m, int i) const { return step_ ? alpha(n, m, i) : theta(n, m, i); }
+  /// Stewart's lambda_{n,m,r}, or its analogue in the step form (dcs::region_multiplier: zero
+  /// exactly where X_{n,m} is in the closure of region r).
+  double region_lambda(const double* w, int n, int m, int r) const;
   /// lambda, mu at t_{n+1} (-1 where the scheme/options give none).
   int lambda_end(int n, int r) const { return lambda_end_[n].empty() ? -1 : lambda_end_[n][r]; }
   int mu_end(int n, int k) const { return mu_end_[n].empty() ? -1 : mu_end_[n][k]; }
@@ -245,6 +262,7 @@ class FesdInterval {
   double held_tol() const { return kHeldTol * in_.T / N_FE_; }
   bool collapsed(const double* w, int n) const { return w[h(n)] <= held_tol(); }
   void build_complementarity();
+  std::vector<nlp::Bound> step_active_set_bounds(const std::vector<std::vector<int>>& active) const;
 
   const Pss& model_;
   Tableau tab_;
@@ -253,7 +271,10 @@ class FesdInterval {
   int N_FE_ = 0, n_s_ = 0;
   bool stiffly_accurate_ = false;
   std::vector<std::vector<int>> x_;
-  std::vector<int> h_, V_, X_, theta_, lambda_, mu_;
+  std::vector<int> h_, V_, X_, theta_, lambda_, mu_, alpha_;
+  bool step_ = false;
+  int n_lam_ = 0, n_mu_ = 0;
+  std::vector<int> owner_;  // subsystem of each region
   std::vector<std::vector<int>> lambda_end_, mu_end_;
   std::vector<bool> boundary_vars_;  // element n has boundary LP variables (33) at t_{n+1}
   std::vector<std::vector<std::vector<int>>> points_;

@@ -124,7 +124,8 @@ bool FesdInterval::regrid(const double* w_old, std::vector<double>& w_new) const
 
 bool FesdInterval::regrid(const double* w_old, std::vector<double>& w_new,
                           const std::vector<int>& count) const {
-  if (!opt_.use_fesd) return false;
+  // (the step form keeps its grid: regridding copies Stewart's per-region multipliers)
+  if (!opt_.use_fesd || step_) return false;
   const int n_x = model_.n_x(), n_th = model_.n_theta(), n_sys = model_.n_sys();
   const double h0 = in_.T / N_FE_;
   const double lb = (1.0 - opt_.gamma_h) * h0, ub = (1.0 + opt_.gamma_h) * h0;
@@ -229,7 +230,7 @@ bool FesdInterval::regrid(const double* w_old, std::vector<double>& w_new,
 
 std::vector<FesdInterval::Touch> FesdInterval::touches(const double* w) const {
   std::vector<Touch> out;
-  if (!opt_.use_fesd) return out;
+  if (!opt_.use_fesd || step_) return out;  // (touches are found in Stewart's form only)
   std::vector<std::vector<int>> active = active_sets(w);
   int prev = -1;  // the last element before n of positive length
   for (int n = 0; n < N_FE_; ++n) {

@@ -1,7 +1,9 @@
 // The active-set step of the integrator: Newton's method on the square system of Thm 15
 // (active_set.hpp, docs/active-set.md).
 #include "integrator/active_set.hpp"
+
 #include "core/util.hpp"
+#include "dcs/step.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -34,9 +36,9 @@ int subsystem_of(const Pss& model, int r) {
 }  // namespace
 
 discretization::IntervalInputs add_step_inputs(nlp::BlockNlp& nlp, const Pss& model, bool use_fesd,
-                                               double T_step) {
+                                               double T_step, DcsMode mode) {
   discretization::IntervalInputs in;
-  const int n_th = model.n_theta(), n_sys = model.n_sys();
+  const int n_th = dcs::n_lambda(model, mode), n_sys = dcs::n_mu(model, mode);
   in.s0 = range_of(nlp.add_variables(model.n_x(), 0.0, 0.0, 0.0), model.n_x());
   in.q = range_of(nlp.add_variables(model.n_u(), 0.0, 0.0, 0.0), model.n_u());
   in.p = range_of(nlp.add_variables(model.n_p(), 0.0, 0.0, 0.0), model.n_p());

@@ -42,9 +42,9 @@ namespace fesd::integrator {
 /// The input variables of one integration step in `nlp`: s0, q, p (fixed by their bounds by the
 /// caller), and for FESD lambda_{0,0}, mu_{0,0} tied to s0 by the LP (9) (lp_at_start); boundary
 /// values at the step end (boundary_at_end). Shared by the homotopy's and the active-set path's
-/// step problems.
+/// step problems. `mode`: the multipliers' sizes (dcs::n_lambda, dcs::n_mu).
 discretization::IntervalInputs add_step_inputs(nlp::BlockNlp& nlp, const Pss& model, bool use_fesd,
-                                               double T_step);
+                                               double T_step, DcsMode mode = DcsMode::Stewart);
 
 /// One Newton solve (or a failed try) of the active-set path.
 struct ActiveSetTry {

@@ -18,6 +18,7 @@
 #include <fmt/ranges.h>
 
 #include "core/option_registry.hpp"
+#include "dcs/step.hpp"
 #include "dcs/stewart.hpp"
 #include "discretization/fesd_interval.hpp"
 #include "fesd/error.hpp"
@@ -45,8 +46,18 @@ void append_step(IntegratorResult& res, const Pss& model, const discretization::
       res.t_stage.push_back(t + tab.c(s) * hn);
       res.x_stage.push_back(gather(w, iv.X(n, s, 0), n_x));
       res.theta.push_back(gather(w, iv.theta(n, s, 0), n_th));
-      res.lambda.push_back(gather(w, iv.lambda(n, s, 0), n_th));
-      res.mu.push_back(gather(w, iv.mu(n, s, 0), n_sys));
+      if (iv.step_mode()) {
+        Eigen::VectorXd lam(n_th);
+        for (int r = 0; r < n_th; ++r) lam[r] = iv.region_lambda(w.data(), n, s, r);
+        res.lambda.push_back(lam);
+        const int n_c = model.n_c();
+        res.alpha.push_back(gather(w, iv.alpha(n, s, 0), n_c));
+        res.lambda_n.push_back(gather(w, iv.lambda(n, s, 0), n_c));
+        res.lambda_p.push_back(gather(w, iv.lambda(n, s, n_c), n_c));
+      } else {
+        res.lambda.push_back(gather(w, iv.lambda(n, s, 0), n_th));
+        res.mu.push_back(gather(w, iv.mu(n, s, 0), n_sys));
+      }
     }
     if (!res.active_set.empty() && res.active_set.back() != active)
       res.switches.push_back(
@@ -75,7 +86,7 @@ std::unique_ptr<StepProblem> build_step_problem(const Pss& model, const Tableau&
                                                 const Eigen::VectorXd& p) {
   auto s = std::make_unique<StepProblem>();
   nlp::BlockNlp& nlp = s->mpcc.nlp();
-  s->in = integrator::add_step_inputs(nlp, model, d.use_fesd, T_step);
+  s->in = integrator::add_step_inputs(nlp, model, d.use_fesd, T_step, d.dcs_mode);
   s->iv = std::make_unique<discretization::FesdInterval>(model, tab, d);
   s->iv->build(nlp, s->in);
   s->mpcc.add_complementarity(s->iv->groups(), s->iv->residual_pairs());
@@ -127,11 +138,14 @@ class Integrator {
     res_.summary.warnings = warnings(options.homotopy);
     settings_cannot_reach_ = !res_.summary.warnings.empty();
     // Initial guess of the first step: the LP at x0 (then the last stage of the step before).
-    guess_ = dcs::solve_lp(model_, x0, p_);
+    guess_ = dcs::solve_start(model_, d_.dcs_mode, x0, p_);
     guess_xdot_ = xdot_at(x0, guess_.theta);
     // The standard method (use_fesd = false) has no free lengths to carry a switch: it always
     // runs on the homotopy path, whatever step_solver says.
-    if (options.step_solver == StepSolver::ActiveSet && d_.use_fesd)
+    // The step form always runs on the homotopy path too (the active-set path's square system is
+    // written in Stewart's form).
+    if (options.step_solver == StepSolver::ActiveSet && d_.use_fesd &&
+        d_.dcs_mode == DcsMode::Stewart)
       active_ = std::make_unique<integrator::ActiveSetStep>(model_, tab_, d_, T_step_, u_, p_);
     StepProblem& first = level(0, 0);
     first.mpcc.finalize();
@@ -147,6 +161,8 @@ class Integrator {
       sens.x0 = Eigen::MatrixXd::Identity(model_.n_x(), model_.n_x());
       sens.u = Eigen::MatrixXd::Zero(model_.n_x(), model_.n_u());
       sens.p = Eigen::MatrixXd::Zero(model_.n_x(), model_.n_p());
+      if (d_.dcs_mode == DcsMode::Step)
+        sensitivity_unavailable("the square system is written in Stewart's form (dcs_mode = step)");
     }
   }
 
@@ -557,7 +573,11 @@ class Integrator {
     const int n_s = d_.n_s;
     for (int r : FesdInterval::exit_regions(model_, res_.active_set.back(), first)) {
       const double th_end = guess_.theta[r];
-      if (th_end <= std::max(FesdInterval::kExitThetaTol, guess_.lambda[r])) continue;
+      const double lam_end = d_.dcs_mode == DcsMode::Step
+                                 ? dcs::region_multiplier(model_, dcs::region_subsystem(model_), r,
+                                                          guess_.lambda.data())
+                                 : guess_.lambda[r];
+      if (th_end <= std::max(FesdInterval::kExitThetaTol, lam_end)) continue;
       // theta_r at the first and last stage of the previous element (res_.theta, res_.t_stage).
       const std::size_t last = res_.theta.size() - 1, first_stage = last + 1 - n_s;
       const double dt = res_.t_stage[last] - res_.t_stage[first_stage];
@@ -769,7 +789,7 @@ class Integrator {
   /// Fixes the start state x_ and sets the guess: lambda, mu at the start from the LP at x_, the
   /// rest continuing the last stage of the step before.
   void set_start(StepProblem& sp) {
-    const dcs::LpSolution lp = dcs::solve_lp(model_, x_, p_);
+    const dcs::LpSolution lp = dcs::solve_start(model_, d_.dcs_mode, x_, p_);
     sp.mpcc.fix(sp.in.s0, x_);
     if (d_.use_fesd) {
       sp.mpcc.set_guess(sp.in.lambda_start, lp.lambda);
@@ -877,10 +897,11 @@ class Integrator {
   void last_stage_guess(const discretization::FesdInterval& iv, const std::vector<double>& w,
                         dcs::LpSolution& lp, Eigen::VectorXd& xdot) const {
     const int last = iv.N_FE() - 1, n_s = d_.n_s;
-    const int n_x = model_.n_x(), n_th = model_.n_theta(), n_sys = model_.n_sys();
+    const int n_x = model_.n_x(), n_th = model_.n_theta();
     lp.theta = gather(w, iv.theta(last, n_s - 1, 0), n_th);
-    lp.lambda = gather(w, iv.lambda(last, n_s - 1, 0), n_th);
-    lp.mu = gather(w, iv.mu(last, n_s - 1, 0), n_sys);
+    lp.lambda = gather(w, iv.lambda(last, n_s - 1, 0), iv.n_lambda());
+    lp.mu = gather(w, iv.mu(last, n_s - 1, 0), iv.n_mu());
+    if (iv.step_mode()) lp.alpha = gather(w, iv.alpha(last, n_s - 1, 0), model_.n_c());
     xdot = gather(w, iv.V(last, n_s - 1, 0), n_x);
   }
 

@@ -39,6 +39,10 @@ std::vector<std::string> stepper_errors(const Pss& model, double h, const Integr
   if (o.sensitivities)
     e.push_back(
         "sensitivities = true: not computed by the Stepper; use integrate() with sensitivities");
+  if (o.discretization.dcs_mode == DcsMode::Step)
+    e.push_back(
+        "discretization.dcs_mode = step: the Stepper runs the active-set path, written in "
+        "Stewart's form; use integrate() for the step form");
   if (model.n_x() < 1) e.push_back("model: empty (n_x = 0)");
   return e;
 }

@@ -179,11 +179,17 @@ std::string describe_model(const Pss& m, bool has_clock) {
 }
 
 std::string describe_discretization(const DiscretizationOptions& d) {
-  if (!d.use_fesd) return "";
-  return line("fesd", fmt::format("gamma_h = {:g}, rho_h = {:g}, stage_lambda_sign = {}, "
-                                  "pin_sliding_exits = {}",
-                                  d.gamma_h, d.rho_h, to_string(d.stage_lambda_sign),
-                                  d.pin_sliding_exits ? 1 : 0));
+  // (the step form is named, Stewart's default form is not)
+  const std::string step = d.dcs_mode == DcsMode::Step
+                               ? line("dcs",
+                                      "dcs_mode = step (Heaviside step form: alpha per "
+                                      "switching function, theta = theta(alpha))")
+                               : "";
+  if (!d.use_fesd) return step;
+  return step + line("fesd", fmt::format("gamma_h = {:g}, rho_h = {:g}, stage_lambda_sign = {}, "
+                                         "pin_sliding_exits = {}",
+                                         d.gamma_h, d.rho_h, to_string(d.stage_lambda_sign),
+                                         d.pin_sliding_exits ? 1 : 0));
 }
 
 std::string describe_ocp_functions(const Ocp& ocp) {

@@ -276,6 +276,11 @@ void json_of_simulation(const IntegratorResult& result, const Model& model,
   j["theta"] = rows(result.theta);
   j["lambda"] = rows(result.lambda);
   j["mu"] = rows(result.mu);
+  if (!result.alpha.empty()) {  // the Heaviside step form (dcs_mode = step)
+    j["alpha"] = rows(result.alpha);
+    j["lambda_p"] = rows(result.lambda_p);
+    j["lambda_n"] = rows(result.lambda_n);
+  }
   j["active_set"] = result.active_set;
   j["switches"] = switches(result.switches);
   j["homotopy"] = homotopy(result.homotopy);
@@ -354,6 +359,11 @@ void json_of_ocp(const OcpResult& result, const Model& model, const std::string&
   j["x_stage"] = rows(result.x_stage);
   j["theta"] = rows(result.theta);
   j["lambda"] = rows(result.lambda);
+  if (!result.alpha.empty()) {  // the Heaviside step form (dcs_mode = step)
+    j["alpha"] = rows(result.alpha);
+    j["lambda_p"] = rows(result.lambda_p);
+    j["lambda_n"] = rows(result.lambda_n);
+  }
   j["active_set"] = result.active_set;
   j["switches"] = switches(result.switches);
   j["state_names"] = names_of(model.state_names, result.x, model.n_x(), 'x');

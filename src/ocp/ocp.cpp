@@ -17,6 +17,7 @@
 #include <fmt/ranges.h>
 
 #include "core/limits.hpp"
+#include "dcs/step.hpp"
 #include "dcs/stewart.hpp"
 #include "discretization/fesd_interval.hpp"
 #include "fesd/error.hpp"
@@ -57,13 +58,17 @@ std::vector<int> intervals_N_FE(const Ocp& ocp, const OcpOptions& o) {
 /// The MPCC of the OCP (59)-(60) and where its pieces live.
 struct OcpNlp : ocp_detail::OcpNlpParts<FesdInterval> {
   std::vector<IntervalInputs> in;
+  DcsMode mode = DcsMode::Stewart;
 };
 
 std::unique_ptr<OcpNlp> build(const Ocp& ocp, const OcpOptions& o, const StageParameters& p) {
   const Pss& m = ocp.model;
   const DiscretizationOptions& d = o.discretization;
-  const int n_x = m.n_x(), n_u = m.n_u(), n_th = m.n_theta(), n_sys = m.n_sys();
+  const int n_x = m.n_x(), n_u = m.n_u();
+  // multipliers per point: Stewart lambda (n_theta), mu (n_sys); step (lambda_n, lambda_p)
+  const int n_th = dcs::n_lambda(m, d.dcs_mode), n_sys = dcs::n_mu(m, d.dcs_mode);
   auto b = std::make_unique<OcpNlp>();
+  b->mode = d.dcs_mode;
   b->tab = make_tableau(d.rk_scheme, d.n_s);
   mpcc::Problem& mp = b->mpcc;
   nlp::BlockNlp& nlp = mp.nlp();
@@ -130,12 +135,12 @@ void guess_constant(OcpNlp& b, const Ocp& ocp, const StageParameters& p) {
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(ocp.model.n_x());
   auto& w = b.mpcc.guess();
   for (std::size_t k = 0; k < b.iv.size(); ++k)
-    b.iv[k]->set_guess(w, ocp.x0, dcs::solve_lp(ocp.model, ocp.x0, p[k]), zero);
-  const dcs::LpSolution lp = dcs::solve_lp(ocp.model, ocp.x0, p.front());
+    b.iv[k]->set_guess(w, ocp.x0, dcs::solve_start(ocp.model, b.mode, ocp.x0, p[k]), zero);
+  const dcs::LpSolution lp = dcs::solve_start(ocp.model, b.mode, ocp.x0, p.front());
   const auto& in0 = b.in.front();
   if (in0.lp_at_start) {
-    for (int r = 0; r < ocp.model.n_theta(); ++r) w[in0.lambda_start[r]] = lp.lambda[r];
-    for (int j = 0; j < ocp.model.n_sys(); ++j) w[in0.mu_start[j]] = lp.mu[j];
+    for (std::size_t r = 0; r < in0.lambda_start.size(); ++r) w[in0.lambda_start[r]] = lp.lambda[r];
+    for (std::size_t j = 0; j < in0.mu_start.size(); ++j) w[in0.mu_start[j]] = lp.mu[j];
   }
   for (int i = 0; i < ocp.model.n_x(); ++i) w[b.s0[i]] = ocp.x0[i];
 }
@@ -149,16 +154,16 @@ void guess_external(OcpNlp& b, const Ocp& ocp, const StageParameters& p) {
   for (std::size_t k = 0; k < b.iv.size(); ++k) {
     const Eigen::VectorXd& a = ocp.x_guess[k];
     const Eigen::VectorXd& e = ocp.x_guess[k + 1];
-    b.iv[k]->set_guess(w, a, dcs::solve_lp(m, 0.5 * (a + e), p[k]), (e - a) / T_k);
+    b.iv[k]->set_guess(w, a, dcs::solve_start(m, b.mode, 0.5 * (a + e), p[k]), (e - a) / T_k);
   }
   const Eigen::VectorXd start = ocp.lbx0.size() > 0 ? ocp.x_guess.front() : ocp.x0;
   for (int i = 0; i < m.n_x(); ++i)
     w[b.s0[i]] = std::clamp(start[i], b.mpcc.lower(b.s0[i]), b.mpcc.upper(b.s0[i]));
   const auto& in0 = b.in.front();
   if (in0.lp_at_start) {
-    const dcs::LpSolution lp = dcs::solve_lp(m, start, p.front());
-    for (int r = 0; r < m.n_theta(); ++r) w[in0.lambda_start[r]] = lp.lambda[r];
-    for (int j = 0; j < m.n_sys(); ++j) w[in0.mu_start[j]] = lp.mu[j];
+    const dcs::LpSolution lp = dcs::solve_start(m, b.mode, start, p.front());
+    for (std::size_t r = 0; r < in0.lambda_start.size(); ++r) w[in0.lambda_start[r]] = lp.lambda[r];
+    for (std::size_t j = 0; j < in0.mu_start.size(); ++j) w[in0.mu_start[j]] = lp.mu[j];
   }
   for (const auto& iv : b.iv) iv->update_lifted_guess(w);
 }
@@ -201,7 +206,9 @@ bool guess_simulation(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Stag
       r.h.insert(r.h.end(), rk.h.begin(), rk.h.end());
       r.x.insert(r.x.end(), rk.x.begin() + 1, rk.x.end());
       for (auto [to, from] : {std::pair{&r.x_stage, &rk.x_stage}, std::pair{&r.theta, &rk.theta},
-                              std::pair{&r.lambda, &rk.lambda}, std::pair{&r.mu, &rk.mu}})
+                              std::pair{&r.lambda, &rk.lambda}, std::pair{&r.mu, &rk.mu},
+                              std::pair{&r.alpha, &rk.alpha}, std::pair{&r.lambda_n, &rk.lambda_n},
+                              std::pair{&r.lambda_p, &rk.lambda_p}})
         to->insert(to->end(), from->begin(), from->end());
     }
   }
@@ -227,16 +234,24 @@ bool guess_simulation(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Stag
           w[iv.X(n, s, i)] = r.x_stage[st][i];
           w[iv.V(n, s, i)] = V[i];
         }
-        for (int k = 0; k < n_th; ++k) {
-          w[iv.theta(n, s, k)] = r.theta[st][k];
-          w[iv.lambda(n, s, k)] = r.lambda[st][k];
+        for (int k = 0; k < n_th; ++k) w[iv.theta(n, s, k)] = r.theta[st][k];
+        if (iv.step_mode()) {
+          const int n_c = m.n_c();
+          for (int j = 0; j < n_c; ++j) {
+            w[iv.alpha(n, s, j)] = r.alpha[st][j];
+            w[iv.alpha(n, s, n_c + j)] = 1.0 - r.alpha[st][j];
+            w[iv.lambda(n, s, j)] = r.lambda_n[st][j];
+            w[iv.lambda(n, s, n_c + j)] = r.lambda_p[st][j];
+          }
+        } else {
+          for (int k = 0; k < n_th; ++k) w[iv.lambda(n, s, k)] = r.lambda[st][k];
+          for (int j = 0; j < n_sys; ++j) w[iv.mu(n, s, j)] = r.mu[st][j];
         }
-        for (int j = 0; j < n_sys; ++j) w[iv.mu(n, s, j)] = r.mu[st][j];
       }
       if (iv.lambda_end(n, 0) >= 0 && !(iv.lambda_end(n, 0) == iv.lambda(n, n_s - 1, 0))) {
-        const dcs::LpSolution lp = dcs::solve_lp(m, r.x[e + 1], pk);
-        for (int k = 0; k < n_th; ++k) w[iv.lambda_end(n, k)] = lp.lambda[k];
-        for (int j = 0; j < n_sys; ++j) w[iv.mu_end(n, j)] = lp.mu[j];
+        const dcs::LpSolution lp = dcs::solve_start(m, b.mode, r.x[e + 1], pk);
+        for (int k = 0; k < iv.n_lambda(); ++k) w[iv.lambda_end(n, k)] = lp.lambda[k];
+        for (int j = 0; j < iv.n_mu(); ++j) w[iv.mu_end(n, j)] = lp.mu[j];
       }
     }
     iv.update_lifted_guess(w);
@@ -254,7 +269,17 @@ void extract(const OcpNlp& b, const Ocp& ocp, const std::vector<double>& w,
       ocp, b.tab, m.n_x(), m.n_u(), b.s0, b.q, b.iv, b.terminal_slacks, w, p, res,
       [&](const FesdInterval& iv, int n, int s) {
         res.theta.push_back(gather(w, iv.theta(n, s, 0), n_th));
-        res.lambda.push_back(gather(w, iv.lambda(n, s, 0), n_th));
+        if (iv.step_mode()) {
+          Eigen::VectorXd lam(n_th);
+          for (int r = 0; r < n_th; ++r) lam[r] = iv.region_lambda(w.data(), n, s, r);
+          res.lambda.push_back(lam);
+          const int n_c = m.n_c();
+          res.alpha.push_back(gather(w, iv.alpha(n, s, 0), n_c));
+          res.lambda_n.push_back(gather(w, iv.lambda(n, s, 0), n_c));
+          res.lambda_p.push_back(gather(w, iv.lambda(n, s, n_c), n_c));
+        } else {
+          res.lambda.push_back(gather(w, iv.lambda(n, s, 0), n_th));
+        }
       },
       [&](const FesdInterval& iv) { return iv.eta(w.data()); });
 }
