@@ -17,7 +17,8 @@
 //   template <class T> T f_q(const T* x, const T* u, const T* p) const;             // Lagrange
 //   term template <class T> T f_q_T(const T* x, const T* p) const;                       // Mayer
 //   term template <class T> void g_path(const T* x, const T* u, const T* p, T* out) const; template
-//   <class T> void g_terminal(const T* x, const T* p, T* out) const;
+//   <class T> void g_terminal(const T* x, const T* p, T* out) const; template <class T> void
+//   g_path_comp(const T* x, const T* u, const T* p, T* out) const;  // a, then b
 //
 // Example (the sensitivity OCP (56): min int_0^2 x^2 dt + (x(2) - 5/3)^2 over x0):
 //
@@ -31,6 +32,7 @@
 //   ocp.T = 2;  ocp.x0 = Eigen::VectorXd::Constant(1, -1.0);  ocp.lbx0 = ...;  ocp.ubx0 = ...;
 //   fesd::OcpResult r = fesd::solve(ocp, options);
 #pragma once
+#include <limits>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -55,13 +57,26 @@ class OcpFunctions {
   virtual ~OcpFunctions() = default;
   virtual bool has_f_q() const = 0;
   virtual bool has_f_q_T() const = 0;
+  /// Path complementarity pairs (OcpData::n_g_path_comp of them): out[i] = a_i(x, u, p),
+  /// out[n + i] = b_i(x, u, p), for 0 <= a_i perp b_i >= 0. Optional (the default writes nothing).
 #define FESD_DECLARE_OCP_FUNCTIONS(T)                                        \
   virtual T f_q(const T* x, const T* u, const T* p) const = 0;               \
   virtual T f_q_T(const T* x, const T* p) const = 0;                         \
   virtual void g_path(const T* x, const T* u, const T* p, T* out) const = 0; \
-  virtual void g_terminal(const T* x, const T* p, T* out) const = 0;
+  virtual void g_terminal(const T* x, const T* p, T* out) const = 0;         \
+  virtual void g_path_comp(const T* /*x*/, const T* /*u*/, const T* /*p*/, T* /*out*/) const {}
   FESD_FOR_EACH_SCALAR(FESD_DECLARE_OCP_FUNCTIONS)
 #undef FESD_DECLARE_OCP_FUNCTIONS
+};
+
+/// A global decision variable (nosnoc: v_global): model parameter `index` becomes an NLP variable
+/// within [lb, ub] with one value for the whole horizon, chosen by the optimizer. Its guess is the
+/// parameter's value (OcpData::p, or the model's p_default; with p_stage the first row). The model
+/// (f, c), the costs and the constraints read it like any parameter.
+struct GlobalVariable {
+  int index = 0;  ///< the parameter, 0 <= index < n_p
+  double lb = -std::numeric_limits<double>::infinity();
+  double ub = std::numeric_limits<double>::infinity();
 };
 
 /// How the terminal constraints are imposed (nosnoc: relax_terminal_constraint).
@@ -107,6 +122,26 @@ struct OcpData {
   Eigen::VectorXd lbg_terminal, ubg_terminal;
   TerminalConstraint terminal_constraint = TerminalConstraint::Hard;
   double rho_terminal = 1e3;  ///< weight of the l1 terminal penalty, > 0
+
+  /// Global decision variables (nosnoc: v_global): parameters the optimizer chooses.
+  std::vector<GlobalVariable> v_global;
+
+  /// Path complementarity constraints (nosnoc: g_path_comp): n_g_path_comp pairs
+  /// 0 <= a_i(x, u, p) perp b_i(x, u, p) >= 0 (OcpFunctions::g_path_comp) at x0 and every element
+  /// boundary (and stage point with constraints_at_stages), each with the interval's control;
+  /// relaxed by the MPCC method and homotopy of FESD's own complementarity constraints.
+  int n_g_path_comp = 0;
+
+  /// Free final time (nosnoc: time_optimal_problem): the time is scaled by a speed of time s > 0,
+  /// dt = s dtau on the nominal horizon tau in [0, T]: the dynamics become s f(x, u, p) and the
+  /// Lagrange term s f_q; the final time T_final = integral of s dtau is added to the cost.
+  bool time_optimal_problem = false;
+  /// One speed of time per control interval instead of one for the whole horizon (nosnoc:
+  /// local_speed_of_time_variable).
+  bool local_speed_of_time_variable = false;
+  double s_sot_min = 0.04;  ///< lower bound of s, > 0 (nosnoc: s_sot_min)
+  double s_sot_max = 25;    ///< upper bound of s (nosnoc: s_sot_max)
+  double s_sot0 = 1;        ///< initial guess of s, within the bounds (nosnoc: s_sot0)
 };
 
 /// An optimal control problem of a piecewise smooth system (Filippov paper, Sect. 5).
@@ -180,6 +215,16 @@ struct OcpResult {
   /// each); theta is then theta(alpha), lambda per region as in IntegratorResult.
   std::vector<Eigen::VectorXd> alpha, lambda_p, lambda_n;
 
+  /// Values of the global decision variables (OcpData::v_global, in its order) and their
+  /// parameter names.
+  Eigen::VectorXd v_global;
+  std::vector<std::string> v_global_names;
+  /// The final time (time_optimal_problem: T_final = sum_k s_k T / N_stages; else T), and the
+  /// speed of time of every control interval (empty without time_optimal_problem). t, h, t_ctrl,
+  /// t_stage and the switch times are physical times.
+  double T_final = 0;
+  std::vector<double> s_sot;
+
   std::vector<HomotopyRow> homotopy;  ///< one row per NLP (a pinned re-solve last)
   Summary summary;                    ///< work and time; n_variables, n_constraints: the NLP
 
@@ -221,24 +266,27 @@ class OcpFunctionsFor final : public OcpFunctions {
       f_.f_q_T(v, v);
     };
   }
-#define FESD_IMPLEMENT_OCP_FUNCTIONS(T)                                             \
-  T f_q(const T* x, const T* u, const T* p) const override {                        \
-    if constexpr (requires { f_.f_q(x, u, p); })                                    \
-      return f_.f_q(x, u, p);                                                       \
-    else                                                                            \
-      return T(0.0);                                                                \
-  }                                                                                 \
-  T f_q_T(const T* x, const T* p) const override {                                  \
-    if constexpr (requires { f_.f_q_T(x, p); })                                     \
-      return f_.f_q_T(x, p);                                                        \
-    else                                                                            \
-      return T(0.0);                                                                \
-  }                                                                                 \
-  void g_path(const T* x, const T* u, const T* p, T* out) const override {          \
-    if constexpr (requires { f_.g_path(x, u, p, out); }) f_.g_path(x, u, p, out);   \
-  }                                                                                 \
-  void g_terminal(const T* x, const T* p, T* out) const override {                  \
-    if constexpr (requires { f_.g_terminal(x, p, out); }) f_.g_terminal(x, p, out); \
+#define FESD_IMPLEMENT_OCP_FUNCTIONS(T)                                                     \
+  T f_q(const T* x, const T* u, const T* p) const override {                                \
+    if constexpr (requires { f_.f_q(x, u, p); })                                            \
+      return f_.f_q(x, u, p);                                                               \
+    else                                                                                    \
+      return T(0.0);                                                                        \
+  }                                                                                         \
+  T f_q_T(const T* x, const T* p) const override {                                          \
+    if constexpr (requires { f_.f_q_T(x, p); })                                             \
+      return f_.f_q_T(x, p);                                                                \
+    else                                                                                    \
+      return T(0.0);                                                                        \
+  }                                                                                         \
+  void g_path(const T* x, const T* u, const T* p, T* out) const override {                  \
+    if constexpr (requires { f_.g_path(x, u, p, out); }) f_.g_path(x, u, p, out);           \
+  }                                                                                         \
+  void g_terminal(const T* x, const T* p, T* out) const override {                          \
+    if constexpr (requires { f_.g_terminal(x, p, out); }) f_.g_terminal(x, p, out);         \
+  }                                                                                         \
+  void g_path_comp(const T* x, const T* u, const T* p, T* out) const override {             \
+    if constexpr (requires { f_.g_path_comp(x, u, p, out); }) f_.g_path_comp(x, u, p, out); \
   }
   FESD_FOR_EACH_SCALAR(FESD_IMPLEMENT_OCP_FUNCTIONS)
 #undef FESD_IMPLEMENT_OCP_FUNCTIONS

@@ -119,9 +119,12 @@ enum class MpccMode {
   FischerBurmeister,
   L1Penalty,    ///< (1 / sigma) * sum of all w1' w2 added to the objective
   ElasticIneq,  ///< w1' w2 <= s, s >= 0 one elastic variable, (1 / sigma) * s in the objective
+  /// -s <= w1' w2 <= s for every complementarity constraint (free-sign ones included), s >= 0
+  /// one elastic variable, (1 / sigma) * s in the objective (nosnoc: ELASTIC_TWO_SIDED)
+  ElasticTwoSided,
 };
 /// Problem-file key `mpcc_mode`: "scholtes_ineq", "scholtes_eq", "fischer_burmeister",
-/// "ell_1_penalty", "elastic_ineq".
+/// "ell_1_penalty", "elastic_ineq", "elastic_two_sided".
 std::string_view to_string(MpccMode v);
 bool parse(std::string_view name, MpccMode& out);
 

@@ -246,6 +246,24 @@ std::vector<Option> build() {
   o.push_back(scalar<&T::ocp, &Ocp::rho_terminal>(kOcp, "rho_terminal", ocp,
                                                   "weight of the ell_1 terminal penalty",
                                                   "rho_terminal", kPositive));
+  o.push_back(input(kOcp, "v_global", ocp,
+                    "global decision variables: parameters of [model] p chosen by the optimizer",
+                    "v_global"));
+  o.push_back(input(kOcp, "g_path_comp", ocp,
+                    "path complementarity pairs 0 <= a perp b >= 0 of expressions", "g_path_comp"));
+  o.push_back(scalar<&T::ocp, &Ocp::time_optimal_problem>(
+      kOcp, "time_optimal_problem", ocp,
+      "free final time: a speed of time s scales the dynamics, T_final is added to the cost",
+      "time_optimal_problem"));
+  o.push_back(scalar<&T::ocp, &Ocp::local_speed_of_time_variable>(
+      kOcp, "local_speed_of_time_variable", ocp, "one speed of time per control interval",
+      "local_speed_of_time_variable"));
+  o.push_back(scalar<&T::ocp, &Ocp::s_sot_min>(
+      kOcp, "s_sot_min", ocp, "lower bound of the speed of time", "s_sot_min", kPositive));
+  o.push_back(scalar<&T::ocp, &Ocp::s_sot_max>(
+      kOcp, "s_sot_max", ocp, "upper bound of the speed of time", "s_sot_max", kPositive));
+  o.push_back(scalar<&T::ocp, &Ocp::s_sot0>(
+      kOcp, "s_sot0", ocp, "initial guess of the speed of time", "s_sot0", kPositive));
   o.push_back(scalar<&T::ocp_options, &OcpOptions::initialization>(kOcp, "initialization", ocp,
                                                                    "initial guess of the NLP", ""));
   o.push_back(scalar<&T::ocp_options, &OcpOptions::constraints_at_stages>(

@@ -23,8 +23,9 @@ constexpr std::array<std::string_view, 4> kCrossComp{"sparse", "stage_sum", "ele
 constexpr std::array<std::string_view, 6> kStepEq{
     "none", "eta", "eta_tanh", "heuristic_mean", "heuristic_delta", "l2_relaxed"};
 constexpr std::array<std::string_view, 3> kStageLambdaSign{"all", "boundary", "auto"};
-constexpr std::array<std::string_view, 5> kMpccMode{
-    "scholtes_ineq", "scholtes_eq", "fischer_burmeister", "ell_1_penalty", "elastic_ineq"};
+constexpr std::array<std::string_view, 6> kMpccMode{"scholtes_ineq",      "scholtes_eq",
+                                                    "fischer_burmeister", "ell_1_penalty",
+                                                    "elastic_ineq",       "elastic_two_sided"};
 // nosnoc's relax_terminal_constraint values that fesd implements.
 constexpr std::array<std::string_view, 2> kTerminalConstraint{"none", "ell_1"};
 constexpr std::array<std::string_view, 3> kOcpInitialization{"constant", "simulation", "external"};

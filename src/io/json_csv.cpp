@@ -348,6 +348,14 @@ void json_of_ocp(const OcpResult& result, const Model& model, const std::string&
   j["switch_times"] = std::move(switch_times);
   j["x0"] = array(result.x0());
   j["x_final"] = array(result.x_final());
+  j["T_final"] = number(result.T_final);
+  if (!result.s_sot.empty()) j["s_sot"] = array(result.s_sot);
+  if (result.v_global.size() > 0) {
+    json v;
+    for (Eigen::Index i = 0; i < result.v_global.size(); ++i)
+      v[result.v_global_names[static_cast<std::size_t>(i)]] = number(result.v_global[i]);
+    j["v_global"] = std::move(v);
+  }
   json homotopy_rows = json::array();
   for (const HomotopyRow& r : result.homotopy) homotopy_rows.push_back(homotopy_row(r));
   j["homotopy"] = std::move(homotopy_rows);

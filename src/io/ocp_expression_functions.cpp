@@ -44,6 +44,7 @@ ExpressionOcpFunctions::ExpressionOcpFunctions(ExpressionLayout layout, OcpExpre
   if (e_.f_q_T) check(*e_.f_q_T, "f_q_T", false);
   for (const expr::Expression& e : e_.g_path) check(e, "g_path", true);
   for (const expr::Expression& e : e_.g_terminal) check(e, "g_terminal", false);
+  for (const expr::Expression& e : e_.g_path_comp) check(e, "g_path_comp", true);
 }
 
 template <class T>
@@ -60,24 +61,27 @@ void ExpressionOcpFunctions::eval(const expr::Expression* list, int n, const T* 
   for (int i = 0; i < n; ++i) out[i] = list[i].template evaluate<T>(symbols);
 }
 
-#define FESD_DEFINE_EXPRESSION_OCP_FUNCTIONS(T)                                           \
-  T ExpressionOcpFunctions::f_q(const T* x, const T* u, const T* p) const {               \
-    if (!e_.f_q) return T(0.0);                                                           \
-    T out(0.0);                                                                           \
-    eval<T>(&*e_.f_q, 1, x, u, p, &out);                                                  \
-    return out;                                                                           \
-  }                                                                                       \
-  T ExpressionOcpFunctions::f_q_T(const T* x, const T* p) const {                         \
-    if (!e_.f_q_T) return T(0.0);                                                         \
-    T out(0.0);                                                                           \
-    eval<T>(&*e_.f_q_T, 1, x, nullptr, p, &out);                                          \
-    return out;                                                                           \
-  }                                                                                       \
-  void ExpressionOcpFunctions::g_path(const T* x, const T* u, const T* p, T* out) const { \
-    eval<T>(e_.g_path.data(), n_g_path(), x, u, p, out);                                  \
-  }                                                                                       \
-  void ExpressionOcpFunctions::g_terminal(const T* x, const T* p, T* out) const {         \
-    eval<T>(e_.g_terminal.data(), n_g_terminal(), x, nullptr, p, out);                    \
+#define FESD_DEFINE_EXPRESSION_OCP_FUNCTIONS(T)                                                \
+  T ExpressionOcpFunctions::f_q(const T* x, const T* u, const T* p) const {                    \
+    if (!e_.f_q) return T(0.0);                                                                \
+    T out(0.0);                                                                                \
+    eval<T>(&*e_.f_q, 1, x, u, p, &out);                                                       \
+    return out;                                                                                \
+  }                                                                                            \
+  T ExpressionOcpFunctions::f_q_T(const T* x, const T* p) const {                              \
+    if (!e_.f_q_T) return T(0.0);                                                              \
+    T out(0.0);                                                                                \
+    eval<T>(&*e_.f_q_T, 1, x, nullptr, p, &out);                                               \
+    return out;                                                                                \
+  }                                                                                            \
+  void ExpressionOcpFunctions::g_path(const T* x, const T* u, const T* p, T* out) const {      \
+    eval<T>(e_.g_path.data(), n_g_path(), x, u, p, out);                                       \
+  }                                                                                            \
+  void ExpressionOcpFunctions::g_terminal(const T* x, const T* p, T* out) const {              \
+    eval<T>(e_.g_terminal.data(), n_g_terminal(), x, nullptr, p, out);                         \
+  }                                                                                            \
+  void ExpressionOcpFunctions::g_path_comp(const T* x, const T* u, const T* p, T* out) const { \
+    eval<T>(e_.g_path_comp.data(), 2 * n_g_path_comp(), x, u, p, out);                         \
   }
 FESD_FOR_EACH_SCALAR(FESD_DEFINE_EXPRESSION_OCP_FUNCTIONS)
 #undef FESD_DEFINE_EXPRESSION_OCP_FUNCTIONS

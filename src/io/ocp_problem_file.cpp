@@ -151,7 +151,8 @@ Eigen::VectorXd append(const Eigen::VectorXd& v, double value);
 /// The guesses and parameters per control interval of [ocp] (once T and N_stages are known):
 /// u_guess (one vector, or one row per interval), x_guess (the states at the control grid points;
 /// a clock state gets t_k; it makes initialization = external unless the file sets it) and
-/// p_time_var ({name = [one value per interval]}, names of [model] p).
+/// p_time_var ({name = [one value per interval]}, names of [model] p); v_global ({name = {guess,
+/// lb, ub}}, names of [model] p, read first: a guess sets the parameter's value).
 void read_stage_data(const Reader& r, const toml::table& t, const std::vector<std::string>& p_names,
                      int n_x_user, int n_u, bool has_clock, OcpData& ocp, OcpOptions& options) {
   const std::string per_state = "one per state in model.x";
@@ -173,6 +174,34 @@ void read_stage_data(const Reader& r, const toml::table& t, const std::vector<st
         ocp.x_guess[k] = append(ocp.x_guess[k], static_cast<double>(k) * ocp.T / ocp.N_stages);
     if (t.get("initialization") == nullptr) options.initialization = OcpInitialization::External;
   }
+  if (const toml::node* n = t.get("v_global")) {  // {name = {guess, lb, ub}}
+    const toml::table& vt = r.table(*n, "ocp.v_global");
+    static constexpr std::array<std::string_view, 3> kKeys{"guess", "lb", "ub"};
+    for (const auto& [key, value] : vt) {
+      const std::string name(key.str());
+      const std::string path = "ocp.v_global." + name;
+      const auto it = std::find(p_names.begin(), p_names.end(), name);
+      if (it == p_names.end())
+        r.fail(value.source(), path,
+               fmt::format("unknown parameter '{}' (expected a name of [model] p)", name));
+      const toml::table& spec = r.table(value, path);
+      r.check_keys(spec, kKeys, path);
+      GlobalVariable v;
+      v.index = static_cast<int>(it - p_names.begin());
+      if (const toml::node* lb = spec.get("lb")) v.lb = r.number(*lb, path + ".lb", true);
+      if (const toml::node* ub = spec.get("ub")) v.ub = r.number(*ub, path + ".ub", true);
+      if (v.lb > v.ub)
+        r.fail(value.source(), path,
+               fmt::format("lb = {} > ub = {}: empty bounds (expected lb <= ub)", v.lb, v.ub));
+      if (const toml::node* g = spec.get("guess")) ocp.p[v.index] = r.number(*g, path + ".guess");
+      if (ocp.p[v.index] < v.lb || ocp.p[v.index] > v.ub)
+        r.fail(value.source(), path,
+               fmt::format("the guess {} is outside [lb, ub] = [{}, {}] (the guess is `guess`, or "
+                           "the parameter's [model] p value)",
+                           ocp.p[v.index], v.lb, v.ub));
+      ocp.v_global.push_back(v);
+    }
+  }
   if (const toml::node* n = t.get("p_time_var")) {
     const toml::table& pt = r.table(*n, "ocp.p_time_var");
     ocp.p_stage.assign(static_cast<std::size_t>(ocp.N_stages), ocp.p);
@@ -186,6 +215,12 @@ void read_stage_data(const Reader& r, const toml::table& t, const std::vector<st
       const Eigen::VectorXd v =
           r.vector(value, path, ocp.N_stages, "one value per control interval, N_stages");
       const auto i = static_cast<Eigen::Index>(it - p_names.begin());
+      for (const GlobalVariable& global : ocp.v_global)
+        if (global.index == i)
+          r.fail(value.source(), path,
+                 fmt::format("'{}' is a global variable (ocp.v_global): one value for the whole "
+                             "horizon, not one per control interval",
+                             name));
       for (int k = 0; k < ocp.N_stages; ++k) ocp.p_stage[static_cast<std::size_t>(k)][i] = v[k];
     }
   }
@@ -214,6 +249,25 @@ OcpExpressions read_ocp_expressions(const Reader& r, const toml::table& t, const
   if (g_terminal != nullptr)
     e.g_terminal = read_expressions(r, *g_terminal, "ocp.g_terminal", sym, false,
                                     "a terminal constraint g_terminal(x, p)");
+  if (const toml::node* n = t.get("g_path_comp")) {  // [[a_1, b_1], [a_2, b_2], ...]
+    const std::string path = "ocp.g_path_comp";
+    const toml::array& pairs = r.array(*n, path, "an array of pairs [a, b] of expressions");
+    if (pairs.empty())
+      r.fail(n->source(), path, "empty (expected at least one pair [a, b] of expressions)");
+    std::vector<expr::Expression> a, b;
+    for (std::size_t i = 0; i < pairs.size(); ++i) {
+      const std::string pi = index(path, i);
+      const toml::array& pair = r.array(pairs[i], pi, "a pair [a, b] of expressions");
+      if (pair.size() != 2)
+        r.fail(pairs[i].source(), pi,
+               fmt::format("{} expressions (expected a pair [a, b]: 0 <= a perp b >= 0)",
+                           pair.size()));
+      a.push_back(r.expression(pair[0], index(pi, 0), sym.all));
+      b.push_back(r.expression(pair[1], index(pi, 1), sym.all));
+    }
+    e.g_path_comp = std::move(a);
+    e.g_path_comp.insert(e.g_path_comp.end(), b.begin(), b.end());
+  }
 
   return e;
 }
@@ -304,7 +358,7 @@ OcpProblem parse_ocp_problem(std::string_view toml_text, std::string_view source
   bool has_clock = spec.uses_time();
   if (e.f_q) has_clock = has_clock || reads_time(*e.f_q);
   if (e.f_q_T) has_clock = has_clock || reads_time(*e.f_q_T);
-  for (const auto* list : {&e.g_path, &e.g_terminal})
+  for (const auto* list : {&e.g_path, &e.g_terminal, &e.g_path_comp})
     has_clock = has_clock || std::any_of(list->begin(), list->end(), reads_time);
 
   // [model] x0 and the Pss; the OCP starts at t = 0.
@@ -321,6 +375,7 @@ OcpProblem parse_ocp_problem(std::string_view toml_text, std::string_view source
   layout.n_p = ocp.model.n_p();
   ocp.n_g_path = static_cast<int>(e.g_path.size());
   ocp.n_g_terminal = static_cast<int>(e.g_terminal.size());
+  ocp.n_g_path_comp = static_cast<int>(e.g_path_comp.size()) / 2;
   // Its layout checks are invariants of this reader (fesd::InternalError), not input errors.
   ocp.functions = std::make_shared<const ExpressionOcpFunctions>(layout, std::move(e));
 
@@ -354,7 +409,7 @@ PdsOcpProblem parse_pds_ocp_problem(std::string_view toml_text, std::string_view
   OcpExpressions e = read_ocp_expressions(r, t, m.sym);
   const auto reads_time = [&](const expr::Expression& x) { return x.depends_on(m.sym.time_index); };
   bool uses_time = (e.f_q && reads_time(*e.f_q)) || (e.f_q_T && reads_time(*e.f_q_T));
-  for (const auto* list : {&e.g_path, &e.g_terminal})
+  for (const auto* list : {&e.g_path, &e.g_terminal, &e.g_path_comp})
     uses_time = uses_time || std::any_of(list->begin(), list->end(), reads_time);
   if (uses_time)
     r.fail(ocp_node->source(), "ocp",
@@ -368,6 +423,7 @@ PdsOcpProblem parse_pds_ocp_problem(std::string_view toml_text, std::string_view
       .n_x = n_x, .n_x_slots = n_x + 1, .n_u = n_u, .n_p = ocp.model.n_p()};
   ocp.n_g_path = static_cast<int>(e.g_path.size());
   ocp.n_g_terminal = static_cast<int>(e.g_terminal.size());
+  ocp.n_g_path_comp = static_cast<int>(e.g_path_comp.size()) / 2;
   ocp.functions = std::make_shared<const ExpressionOcpFunctions>(layout, std::move(e));
   read_ocp_bounds(r, t, n_x, n_u, /*has_clock=*/false, ocp);
   read_options(r, root, problem, [&] {

@@ -127,12 +127,24 @@ Relaxation::Relaxation(nlp::BlockNlp& nlp, const std::vector<CompGroup>& groups,
   // keep one layout.
   if (mode == MpccMode::FischerBurmeister)  // sigma enters the rows as a variable fixed by bounds
     sigma_var_ = nlp.add_variables(1, 1.0, 1.0, 1.0);  // IPOPT removes it (make_parameter)
-  if (mode == MpccMode::ElasticIneq) elastic_var_ = nlp.add_variables(1, 0.0, nlp::kInf, 0.0);
+  const bool elastic = mode == MpccMode::ElasticIneq || mode == MpccMode::ElasticTwoSided;
+  if (elastic) elastic_var_ = nlp.add_variables(1, 0.0, nlp::kInf, 0.0);
 
   for (std::size_t k = 0; k < groups.size(); ++k) {
     const CompGroup& g = groups[k];
-    if (g.pairs.empty()) continue;  // identically zero: = sigma would be infeasible
-    if (g.two_sided) {              // free-sign product: Scholtes in every mode (header)
+    if (g.pairs.empty()) continue;            // identically zero: = sigma would be infeasible
+    if (mode == MpccMode::ElasticTwoSided) {  // G - s <= 0 and G + s >= 0, every group
+      for (const bool upper : {true, false}) {
+        LocalGroup lg = localize(g);
+        lg.vars.push_back(elastic_var_);
+        (upper ? lg.sum.minus_last : lg.sum.plus_last) = true;
+        const int row = nlp.add_constraint(nlp::make_block(std::move(lg.sum)), std::move(lg.vars),
+                                           upper ? -nlp::kInf : 0.0, upper ? 0.0 : nlp::kInf);
+        if (upper) group_rows_[k] = row;
+      }
+      continue;
+    }
+    if (g.two_sided) {  // free-sign product: Scholtes in every mode (header)
       group_rows_[k] = add_product_row(nlp, g, -1.0, 1.0);
       two_sided_rows_.push_back(group_rows_[k]);
       continue;
@@ -161,10 +173,11 @@ Relaxation::Relaxation(nlp::BlockNlp& nlp, const std::vector<CompGroup>& groups,
         break;
       }
       case MpccMode::ScholtesIneq:
+      case MpccMode::ElasticTwoSided:
         break;  // handled above
     }
   }
-  if (mode == MpccMode::ElasticIneq)
+  if (elastic)
     objectives_.push_back(nlp.add_objective(nlp::make_block(Identity{}), {elastic_var_}, 1.0));
 }
 

@@ -16,6 +16,11 @@
 //                       complementarity pair.
 //   ell_1_penalty       objective += (1 / sigma) * sum of all G      (no rows)
 //   elastic_ineq        G <= s for every group with one variable s >= 0, objective += s / sigma
+//   elastic_two_sided   -s <= G <= s for every group (two-sided ones included: the one mode in
+//                       which a free-sign product is penalized rather than Scholtes-bounded, by
+//                       the bound s on |G|), one s >= 0, objective += s / sigma (nosnoc:
+//                       ELASTIC_TWO_SIDED). For groups with G >= 0 the lower row is inactive and
+//                       the mode equals elastic_ineq.
 //
 // ell_1_penalty and elastic_ineq are exact penalties: once 1 / sigma exceeds the multipliers of
 // the complementarity constraints, their NLP solution is complementary (up to IPOPT's tolerance),
@@ -27,9 +32,9 @@
 // sliding mode ends), where the relaxed NLPs are degenerate.
 //
 // Two-sided groups (CompGroup::two_sided: b is a lambda without sign condition, so a_p b_p has no
-// sign) stay Scholtes rows -sigma <= G <= sigma in every mode: a product of free sign can neither
-// be penalized (it would be driven to -inf), nor smoothed by a C-function (which needs b >= 0),
-// nor be set = sigma (its sign is not known in advance).
+// sign) stay Scholtes rows -sigma <= G <= sigma in every mode but elastic_two_sided: a product of
+// free sign can neither be penalized (it would be driven to -inf), nor smoothed by a C-function
+// (which needs b >= 0), nor be set = sigma (its sign is not known in advance).
 #pragma once
 #include <vector>
 
@@ -60,7 +65,7 @@ class Relaxation {
   const std::vector<int>& group_rows() const { return group_rows_; }
   /// The NLP variable fixed to sigma by its bounds (fischer_burmeister), else -1.
   int sigma_variable() const { return sigma_var_; }
-  /// The elastic variable s (elastic_ineq), else -1.
+  /// The elastic variable s (elastic_ineq, elastic_two_sided), else -1.
   int elastic_variable() const { return elastic_var_; }
 
  private:

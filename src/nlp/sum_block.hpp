@@ -35,18 +35,21 @@ struct Sum {
 };
 
 /// c[0] = sum_p w[a_p] * w[b_p] over local indices (pairs), with `minus_last` minus the extra
-/// input w[k] (the elastic variable s: sum - s). Inputs: k (+ 1 with minus_last).
+/// input w[k] (the elastic variable s: sum - s), with `plus_last` plus it (sum + s). Inputs: k
+/// (+ 1 with minus_last or plus_last).
 struct ProductSum {
   std::vector<std::pair<int, int>> pairs;
   int k = 0;  ///< inputs read by the pairs (local indices 0..k-1)
   bool minus_last = false;
-  int num_inputs() const { return minus_last ? k + 1 : k; }
+  bool plus_last = false;
+  bool has_last() const { return minus_last || plus_last; }
+  int num_inputs() const { return has_last() ? k + 1 : k; }
   int num_outputs() const { return 1; }
   template <class T>
   void operator()(const T* w, T* c) const {
     T s(0.0);
     for (const auto& [a, b] : pairs) s = s + w[a] * w[b];
-    c[0] = minus_last ? s - w[k] : s;
+    c[0] = minus_last ? s - w[k] : plus_last ? s + w[k] : s;
   }
 };
 
@@ -97,7 +100,7 @@ class ProductSumBlock final : public OneOutputBlock<ProductSum> {
         J[b] += w[a];
       }
     }
-    if (f_.minus_last) J[f_.k] = -1.0;
+    if (f_.has_last()) J[f_.k] = f_.minus_last ? -1.0 : 1.0;
     bool ok = std::isfinite(c[0]);
     for (int i = 0; i < k; ++i) ok = ok && std::isfinite(J[i]);
     return ok;
@@ -119,7 +122,7 @@ class ProductSumBlock final : public OneOutputBlock<ProductSum> {
       row.push_back(a);
       row.push_back(b);
     }
-    if (f_.minus_last) row.push_back(f_.k);
+    if (f_.has_last()) row.push_back(f_.k);
     std::sort(row.begin(), row.end());
     row.erase(std::unique(row.begin(), row.end()), row.end());
     bp.jac_rows.assign(1, std::move(row));

@@ -30,6 +30,7 @@
 #include "ocp/ocp_checks.hpp"
 #include "ocp/ocp_input.hpp"
 #include "ocp/ocp_terms.hpp"
+#include "ocp/speed_of_time.hpp"
 
 namespace fesd {
 namespace {
@@ -121,7 +122,7 @@ std::unique_ptr<OcpNlp> build(const Ocp& ocp, const OcpOptions& o, const StagePa
   }
 
   ocp_detail::add_ocp_terms(mp, ocp, o, b->tab, n_x, n_u, b->s0, b->p_k, b->q, b->iv,
-                            b->terminal_slacks);
+                            b->terminal_slacks, b->comp_points);
   for (const auto& iv : b->iv) mp.add_complementarity(iv->groups(), iv->residual_pairs());
   mp.relax(o.homotopy.mpcc_mode);
   return b;
@@ -262,8 +263,9 @@ bool guess_simulation(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Stag
 // ---- results -----------------------------------------------------------------------------------
 
 void extract(const OcpNlp& b, const Ocp& ocp, const std::vector<double>& w,
-             const StageParameters& p, OcpResult& res) {
+             const StageParameters& /*fixed*/, OcpResult& res) {
   const Pss& m = ocp.model;
+  const StageParameters p = ocp_detail::solution_parameters(b.p_k, w);  // free ones included
   const int n_th = m.n_theta();
   ocp_detail::extract_result(
       ocp, b.tab, m.n_x(), m.n_u(), b.s0, b.q, b.iv, b.terminal_slacks, w, p, res,
@@ -650,10 +652,13 @@ namespace {
 
 /// solve() with the allocation `count` forced after the homotopy (ocp_detail::solve_allocation)
 /// when `count` is not null; `applied` tells whether it could be.
-OcpResult solve_impl(const Ocp& ocp, const OcpOptions& options, const std::vector<int>* count,
+OcpResult solve_impl(const Ocp& user, const OcpOptions& options, const std::vector<int>* count,
                      bool* applied) {
   const auto t_start = Clock::now();
-  ocp_detail::require_valid_input(ocp, options);  // src/ocp/ocp_input.cpp, shared with files
+  ocp_detail::require_valid_input(user, options);  // src/ocp/ocp_input.cpp, shared with files
+  // A time-optimal problem is solved on the nominal horizon with the speed of time as one more
+  // parameter (speed_of_time.hpp); otherwise ocp is a copy of user.
+  const Ocp ocp = ocp_detail::with_speed_of_time(user);
   const StageParameters p = ocp_detail::stage_parameters(ocp, ocp.model.p_default);  // checked
 
   std::unique_ptr<OcpNlp> b = build(ocp, options, p);
@@ -667,6 +672,7 @@ OcpResult solve_impl(const Ocp& ocp, const OcpOptions& options, const std::vecto
     guess_external(*b, ocp, p);
   else if (!simulated)
     guess_constant(*b, ocp, p);
+  ocp_detail::guess_path_comp(*b, ocp, ocp.model.n_x(), ocp.model.n_u());
   mp.finalize();
   res.summary.warnings = warnings(options.homotopy);
   res.summary.n_variables = mp.num_variables();
@@ -719,6 +725,14 @@ OcpResult solve_impl(const Ocp& ocp, const OcpOptions& options, const std::vecto
   }
   ocp_detail::set_outcome(hr, res);
   extract(*b, ocp, mp.solution(), p, res);
+  ocp_detail::extract_globals(user, user.model.parameter_names, b->p, mp.solution(), res);
+  res.T_final = ocp.T;
+  if (ocp.time_optimal_problem) {
+    std::vector<double> s;
+    const int i_s = ocp.model.n_p() - 1;
+    for (const std::vector<int>& pk : b->p_k) s.push_back(mp.solution()[pk[i_s]]);
+    ocp_detail::to_physical_time(res, s, ocp.T / ocp.N_stages);
+  }
   if (options.initialization == OcpInitialization::Simulation && !simulated)
     res.message += " [the initializing simulation failed or used another grid: constant guess]";
   res.summary.wall_s = seconds_since(t_start);
@@ -744,10 +758,15 @@ std::string OcpResult::brief_report() const {
   if (!x.empty())
     for (Eigen::Index i = 0; i < x.front().size(); ++i)
       x0s += fmt::format("{}{:.10g}", i ? ", " : "", x.front()[i]);
+  std::string extra;
+  if (!s_sot.empty()) extra += fmt::format(", T_final = {:.10g}", T_final);
+  for (Eigen::Index i = 0; i < v_global.size(); ++i)
+    extra +=
+        fmt::format(", {} = {:.10g}", v_global_names[static_cast<std::size_t>(i)], v_global[i]);
   return fmt::format(
-      "{}: objective {:.10g}, x(0) = [{}], {} switch{}, {} NLPs, {} IPOPT "
+      "{}: objective {:.10g}, x(0) = [{}]{}, {} switch{}, {} NLPs, {} IPOPT "
       "iterations, {:.3f} s",
-      to_string(status), objective, x0s, switches.size(), switches.size() == 1 ? "" : "es",
+      to_string(status), objective, x0s, extra, switches.size(), switches.size() == 1 ? "" : "es",
       summary.homotopy_steps, summary.nlp_iterations, summary.wall_s);
 }
 
@@ -767,6 +786,13 @@ std::string OcpResult::full_report(bool with_homotopy_table) const {
     os << fmt::format("  x(0)                 {}\n", vec(x.front()));
     os << fmt::format("  x(T)                 {}\n", vec(x.back()));
   }
+  if (!s_sot.empty())
+    os << fmt::format("  T_final              {:.12g} (speed of time {})\n", T_final,
+                      vec(Eigen::Map<const Eigen::VectorXd>(
+                          s_sot.data(), static_cast<Eigen::Index>(s_sot.size()))));
+  for (Eigen::Index i = 0; i < v_global.size(); ++i)
+    os << fmt::format("  v_global             {} = {:.12g}\n",
+                      v_global_names[static_cast<std::size_t>(i)], v_global[i]);
   os << fmt::format("  switches             {}\n", switches.size());
   for (const auto& s : switches) os << format_switch(s);
   os << fmt::format("  NLP size             {} variables, {} constraints\n", summary.n_variables,

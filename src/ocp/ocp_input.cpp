@@ -154,6 +154,44 @@ void check_data(std::vector<std::string>& e, const OcpData& ocp, const ModelSize
   check_rows(ocp.x_guess, ocp.N_stages + 1, "ocp.x_guess",
              "one per control grid point t_k = k T / N_stages, k = 0..N_stages", n_x,
              "one per state", nothing);
+  // Global variables: distinct parameters, bounds, the parameter's value (their guess) within.
+  const Eigen::VectorXd& p = ocp.p.size() > 0 ? ocp.p : m.p_default;
+  for (std::size_t i = 0; i < ocp.v_global.size(); ++i) {
+    const GlobalVariable& v = ocp.v_global[i];
+    const std::string path = fmt::format("ocp.v_global[{}]", i);
+    if (v.index < 0 || v.index >= m.n_p) {
+      e.push_back(
+          fmt::format("{}.index = {}: not a parameter of the model (expected 0 <= index < "
+                      "n_p = {})",
+                      path, v.index, m.n_p));
+      continue;
+    }
+    for (std::size_t j = 0; j < i; ++j)
+      if (ocp.v_global[j].index == v.index)
+        e.push_back(
+            fmt::format("{}: parameter {} is already global variable {} (expected each "
+                        "parameter once)",
+                        path, v.index, j));
+    if (std::isnan(v.lb) || std::isnan(v.ub) || v.lb > v.ub) {
+      e.push_back(fmt::format("{}: bounds [lb, ub] = [{}, {}] are empty or NaN (expected lb <= ub)",
+                              path, v.lb, v.ub));
+      continue;
+    }
+    const double guess = ocp.p_stage.empty() || ocp.p_stage.front().size() != m.n_p
+                             ? (p.size() == m.n_p ? p[v.index] : 0.0)
+                             : ocp.p_stage.front()[v.index];
+    if (guess < v.lb || guess > v.ub)
+      e.push_back(
+          fmt::format("{}: its guess {} (the parameter's value) is outside [lb, ub] = [{}, "
+                      "{}]",
+                      path, guess, v.lb, v.ub));
+  }
+  if (ocp.n_g_path_comp < 0)
+    e.push_back(fmt::format("ocp.n_g_path_comp = {}: must be >= 0", ocp.n_g_path_comp));
+  if (ocp.n_g_path_comp > 0 && !ocp.functions)
+    e.push_back(
+        "ocp.functions: none, but path complementarity pairs are declared (n_g_path_comp "
+        "> 0)");
   if (ocp.n_g_path < 0) e.push_back(fmt::format("ocp.n_g_path = {}: must be >= 0", ocp.n_g_path));
   if (ocp.n_g_terminal < 0)
     e.push_back(fmt::format("ocp.n_g_terminal = {}: must be >= 0", ocp.n_g_terminal));
@@ -182,6 +220,12 @@ OcpInputErrors check_common(const Problem& ocp, const OcpOptions& options, const
   if (external && ocp.x_guess.empty())
     e.options.push_back(
         "ocp.initialization = external: needs x_guess (the states at the control grid points)");
+  if (ocp.time_optimal_problem && ocp.s_sot_min > 0 &&
+      !(ocp.s_sot_min <= ocp.s_sot0 && ocp.s_sot0 <= ocp.s_sot_max))
+    e.options.push_back(fmt::format(
+        "ocp.s_sot0 = {}: the guess of the speed of time must lie within [s_sot_min, s_sot_max] "
+        "= [{}, {}]",
+        ocp.s_sot0, ocp.s_sot_min, ocp.s_sot_max));
   if (!external && !ocp.x_guess.empty())
     e.options.push_back(
         fmt::format("ocp.initialization = {}: x_guess is given but used only with initialization = "
@@ -221,7 +265,9 @@ OcpInputErrors check_input(const PdsOcp& ocp, const OcpOptions& options) {
              {std::pair{!ocp.p_stage.empty(), "p_time_var (ocp.p_stage)"},
               std::pair{!ocp.u_guess_stage.empty(), "u_guess per control interval"},
               std::pair{options.initialization == OcpInitialization::External,
-                        "initialization = external (x_guess)"}})
+                        "initialization = external (x_guess)"},
+              std::pair{ocp.time_optimal_problem, "time_optimal_problem"},
+              std::pair{ocp.n_g_path_comp > 0, "g_path_comp (path complementarity)"}})
           if (given)
             e.options.push_back(fmt::format("ocp.{}: not supported for projected models yet", key));
         if (!ocp.N_FE.empty() && d.use_fesd)

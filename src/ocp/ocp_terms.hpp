@@ -6,6 +6,7 @@
 // X(n, i, j), h(n), N_FE(), n_s().
 #pragma once
 #include <algorithm>
+#include <cmath>
 #include <memory>
 #include <string>
 #include <vector>
@@ -102,6 +103,22 @@ struct TerminalConstraintEq {
   }
 };
 
+/// The path complementarity functions at one point with their lifted variables A, B >= 0:
+/// outputs a(x, q, p) - A and b(x, q, p) - B (= 0).  inputs: x (n_x), q (n_u), p (n_p), A (n),
+/// B (n)
+struct PathCompEq {
+  const OcpFunctions* f;
+  int n_x, n_u, n_p, n;
+  int num_inputs() const { return n_x + n_u + n_p + 2 * n; }
+  int num_outputs() const { return 2 * n; }
+  template <class T>
+  void operator()(const T* w, T* c) const {
+    f->g_path_comp(w, w + n_x, w + n_x + n_u, c);
+    const T* lifted = w + n_x + n_u + n_p;
+    for (int i = 0; i < 2 * n; ++i) c[i] = c[i] - lifted[i];
+  }
+};
+
 /// The messages of the cost and constraint blocks with more than ad::kMaxInputs inputs (each
 /// starts with the problem-file key to change).
 std::vector<std::string> cost_block_size_errors(const OcpData& ocp, int n_x, int n_u, int n_p,
@@ -138,7 +155,35 @@ struct OcpNlpParts {
   std::vector<std::vector<int>> q;    // per interval
   std::vector<std::unique_ptr<Interval>> iv;
   std::vector<int> terminal_slacks;
+  /// Path complementarity points: the inputs x, q, p of PathCompEq and the first of its lifted
+  /// variables (A then B, 2 n_g_path_comp).
+  struct CompPoint {
+    std::vector<int> inputs;
+    int lifted = -1;
+  };
+  std::vector<CompPoint> comp_points;
 };
+
+// ---- decision variables ------------------------------------------------------------------------
+
+/// A parameter the optimizer chooses: a global variable (OcpData::v_global; one NLP variable), or
+/// (per_interval) the speed of time of a time-optimal problem with local speeds (one per control
+/// interval).
+struct FreeParameter {
+  int index;
+  double lb, ub;
+  bool per_interval;
+};
+
+/// The free parameters of an OCP with n_p parameters; with time_optimal_problem the speed of time
+/// is the last parameter (the OCP is the one with_speed_of_time() made).
+inline std::vector<FreeParameter> free_parameters(const OcpData& ocp, int n_p) {
+  std::vector<FreeParameter> f;
+  for (const GlobalVariable& v : ocp.v_global) f.push_back({v.index, v.lb, v.ub, false});
+  if (ocp.time_optimal_problem)
+    f.push_back({n_p - 1, ocp.s_sot_min, ocp.s_sot_max, ocp.local_speed_of_time_variable});
+  return f;
+}
 
 // ---- decision variables ------------------------------------------------------------------------
 
@@ -157,18 +202,37 @@ inline void add_start_and_parameters(mpcc::Problem& mp, const OcpData& ocp,
     for (int i = 0; i < n_x; ++i)
       mp.bound(s0[i], std::max(lower(ocp.lbx0, i), lower(ocp.lbx, i)),
                std::min(upper(ocp.ubx0, i), upper(ocp.ubx, i)));
-  p_vars = range(nlp.add_variables(static_cast<int>(p.size()), 0.0, 0.0, 0.0),
-                 static_cast<int>(p.size()));
+  const int n_p = static_cast<int>(p.size());
+  p_vars = range(nlp.add_variables(n_p, 0.0, 0.0, 0.0), n_p);
   mp.fix(p_vars, p);
+  const std::vector<FreeParameter> free = free_parameters(ocp, n_p);
+  auto make_free = [&](int var, const FreeParameter& f) {
+    mp.bound(var, std::max(f.lb, -nlp::kInf), std::min(f.ub, nlp::kInf));
+    mp.guess()[var] = std::clamp(mp.guess()[var], mp.lower(var), mp.upper(var));
+  };
+  for (const FreeParameter& f : free) make_free(p_vars[f.index], f);
   p_k.assign(1, p_vars);
+  const bool local =
+      std::any_of(free.begin(), free.end(), [](const FreeParameter& f) { return f.per_interval; });
   for (std::size_t k = 1; k < p_stage.size(); ++k) {
-    if (ocp.p_stage.empty()) {
+    if (ocp.p_stage.empty() && !local) {
       p_k.push_back(p_vars);
-    } else {
-      p_k.push_back(range(nlp.add_variables(static_cast<int>(p.size()), 0.0, 0.0, 0.0),
-                          static_cast<int>(p.size())));
-      mp.fix(p_k.back(), p_stage[k]);
+      continue;
     }
+    std::vector<int> pk = p_vars;
+    if (!ocp.p_stage.empty()) {  // own values, fixed
+      pk = range(nlp.add_variables(n_p, 0.0, 0.0, 0.0), n_p);
+      mp.fix(pk, p_stage[k]);
+    }
+    for (const FreeParameter& f : free) {
+      if (!f.per_interval) {
+        pk[f.index] = p_vars[f.index];  // one variable for every interval
+      } else {
+        pk[f.index] = nlp.add_variables(1, 0.0, 0.0, p[f.index]);
+        make_free(pk[f.index], f);
+      }
+    }
+    p_k.push_back(std::move(pk));
   }
 }
 
@@ -195,7 +259,8 @@ void add_ocp_terms(mpcc::Problem& mp, const OcpData& ocp, const OcpOptions& o, c
                    int n_x, int n_u, const std::vector<int>& s0,
                    const std::vector<std::vector<int>>& p_k, const std::vector<std::vector<int>>& q,
                    const std::vector<std::unique_ptr<Interval>>& iv,
-                   std::vector<int>& terminal_slacks) {
+                   std::vector<int>& terminal_slacks,
+                   std::vector<typename OcpNlpParts<Interval>::CompPoint>& comp_points) {
   nlp::BlockNlp& nlp = mp.nlp();
   const int n_p = static_cast<int>(p_k.front().size());
   const OcpFunctions* f = ocp.functions.get();
@@ -214,12 +279,28 @@ void add_ocp_terms(mpcc::Problem& mp, const OcpData& ocp, const OcpOptions& o, c
       mp.bound(first + i, std::max(mp.lower(first + i), lower(ocp.lbx, i)),
                std::min(mp.upper(first + i), upper(ocp.ubx, i)));
   };
+  const int n_comp = ocp.n_g_path_comp;
+  auto comp = n_comp > 0 ? nlp::make_block(PathCompEq{f, n_x, n_u, n_p, n_comp}) : nullptr;
+  std::vector<discretization::CompGroup> comp_groups;
+  std::vector<discretization::CompPair> comp_pairs;
   auto add_path = [&](int x_first, const std::vector<int>& qk, const std::vector<int>& pk) {
-    if (!path) return;
     std::vector<int> vars = range(x_first, n_x);
     vars.insert(vars.end(), qk.begin(), qk.end());
     vars.insert(vars.end(), pk.begin(), pk.end());
-    nlp.add_constraint(path, vars, path_lb, path_ub);
+    if (path) nlp.add_constraint(path, vars, path_lb, path_ub);
+    if (!comp) return;
+    // 0 <= A perp B >= 0 with A = a(x, q, p), B = b(x, q, p): lifted, so that the relaxation
+    // sees products of variables with sign bounds as FESD's own pairs.
+    const int lifted = nlp.add_variables(2 * n_comp, 0.0, nlp::kInf, 0.0);
+    comp_points.push_back({vars, lifted});
+    for (int i = 0; i < 2 * n_comp; ++i) vars.push_back(lifted + i);
+    nlp.add_constraint(comp, vars, std::vector<double>(2 * n_comp, 0.0),
+                       std::vector<double>(2 * n_comp, 0.0));
+    for (int i = 0; i < n_comp; ++i) {
+      const discretization::CompPair pair{lifted + i, lifted + n_comp + i};
+      comp_groups.push_back({{pair}, false});
+      comp_pairs.push_back(pair);
+    }
   };
   add_path(s0[0], q[0], p_k[0]);
   for (std::size_t k = 0; k < iv.size(); ++k) {
@@ -242,6 +323,8 @@ void add_ocp_terms(mpcc::Problem& mp, const OcpData& ocp, const OcpOptions& o, c
       }
     }
   }
+
+  if (comp) mp.add_complementarity(comp_groups, comp_pairs);
 
   // ---- terminal cost and constraints at s_N ----
   const Interval& last = *iv.back();
@@ -354,6 +437,70 @@ void extract_result(const OcpData& ocp, const Tableau& tab, int n_x, int n_u,
   }
   res.t_ctrl.push_back(ocp.T);
   res.objective = objective.total(res.x.back(), w, terminal_slacks);
+}
+
+/// The guess of the lifted path complementarity variables: a(x, q, p) and b(x, q, p) at the
+/// guess of their inputs, clamped to >= 0. After the guess of everything else.
+template <class Parts>
+void guess_path_comp(Parts& b, const OcpData& ocp, int n_x, int n_u) {
+  const int n = ocp.n_g_path_comp;
+  std::vector<double>& w = b.mpcc.guess();
+  std::vector<double> out(static_cast<std::size_t>(2 * n));
+  for (const auto& point : b.comp_points) {
+    std::vector<double> in;
+    for (int v : point.inputs) in.push_back(w[v]);
+    ocp.functions->g_path_comp(in.data(), in.data() + n_x, in.data() + n_x + n_u, out.data());
+    for (int i = 0; i < 2 * n; ++i)
+      w[point.lifted + i] = std::isfinite(out[i]) ? std::max(out[i], 0.0) : 0.0;
+  }
+}
+
+/// The parameter values of every control interval at the NLP point w (free parameters included).
+inline StageParameters solution_parameters(const std::vector<std::vector<int>>& p_k,
+                                           const std::vector<double>& w) {
+  StageParameters out;
+  for (const std::vector<int>& vars : p_k) {
+    Eigen::VectorXd v(static_cast<Eigen::Index>(vars.size()));
+    for (std::size_t i = 0; i < vars.size(); ++i) v[static_cast<Eigen::Index>(i)] = w[vars[i]];
+    out.push_back(std::move(v));
+  }
+  return out;
+}
+
+/// The values and names of the global variables at w (p_vars: the parameters' NLP variables).
+inline void extract_globals(const OcpData& ocp, const std::vector<std::string>& p_names,
+                            const std::vector<int>& p_vars, const std::vector<double>& w,
+                            OcpResult& res) {
+  res.v_global.resize(static_cast<Eigen::Index>(ocp.v_global.size()));
+  res.v_global_names.clear();
+  for (std::size_t i = 0; i < ocp.v_global.size(); ++i) {
+    const int k = ocp.v_global[i].index;
+    res.v_global[static_cast<Eigen::Index>(i)] = w[p_vars[k]];
+    res.v_global_names.push_back(
+        static_cast<std::size_t>(k) < p_names.size() ? p_names[k] : fmt::format("p{}", k + 1));
+  }
+}
+
+/// The times of a result on the nominal grid (tau in [0, T], control intervals of length T_k)
+/// mapped to physical time t = sum_{j < k} s_j T_k + s_k (tau - k T_k) with the speeds s_k of
+/// the control intervals; T_final and s_sot set.
+inline void to_physical_time(OcpResult& res, const std::vector<double>& s, double T_k) {
+  std::vector<double> start(s.size() + 1, 0.0);  // physical start of each interval
+  for (std::size_t k = 0; k < s.size(); ++k) start[k + 1] = start[k] + s[k] * T_k;
+  const auto phys = [&](double tau) {
+    const double kk = std::floor(tau / T_k);
+    const std::size_t k =
+        static_cast<std::size_t>(std::clamp(kk, 0.0, static_cast<double>(s.size() - 1)));
+    return start[k] + s[k] * (tau - static_cast<double>(k) * T_k);
+  };
+  for (double& t : res.t) t = phys(t);
+  for (double& t : res.t_stage) t = phys(t);
+  for (double& t : res.t_ctrl) t = phys(t);
+  for (SwitchEvent& e : res.switches) e.t = phys(e.t);
+  for (std::size_t e = 0; e < res.h.size(); ++e)
+    res.h[e] *= s[static_cast<std::size_t>(res.interval[e])];
+  res.s_sot = s;
+  res.T_final = start.back();
 }
 
 /// The outcome of the homotopy in the result: status, complementarity residual, message.

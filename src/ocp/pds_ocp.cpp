@@ -52,7 +52,7 @@ std::unique_ptr<PdsOcpNlp> build(const PdsOcp& ocp, const OcpOptions& o,
     b->iv.back()->build(mp.nlp(), in);
   }
   ocp_detail::add_ocp_terms(mp, ocp, o, b->tab, m.n_x(), m.n_u(), b->s0, b->p_k, b->q, b->iv,
-                            b->terminal_slacks);
+                            b->terminal_slacks, b->comp_points);
   for (const auto& iv : b->iv) mp.add_complementarity(iv->groups(), iv->residual_pairs());
   mp.relax(o.homotopy.mpcc_mode);
   return b;
@@ -73,8 +73,9 @@ void guess_constant(PdsOcpNlp& b, const PdsOcp& ocp, const ocp_detail::StagePara
 }
 
 void extract(const PdsOcpNlp& b, const PdsOcp& ocp, const std::vector<double>& w,
-             const ocp_detail::StageParameters& p, OcpResult& res) {
+             const ocp_detail::StageParameters& /*fixed*/, OcpResult& res) {
   const int n_c = ocp.model.n_c();
+  const ocp_detail::StageParameters p = ocp_detail::solution_parameters(b.p_k, w);
   ocp_detail::extract_result(
       ocp, b.tab, ocp.model.n_x(), ocp.model.n_u(), b.s0, b.q, b.iv, b.terminal_slacks, w, p, res,
       [&](const PdsInterval& iv, int n, int s) {
@@ -129,6 +130,8 @@ OcpResult solve(const PdsOcp& ocp, const OcpOptions& options) {
   }
   ocp_detail::set_outcome(hr, res);
   extract(*b, ocp, mp.solution(), p, res);
+  ocp_detail::extract_globals(ocp, ocp.model.parameter_names, b->p, mp.solution(), res);
+  res.T_final = ocp.T;
   res.summary.wall_s = seconds_since(t_start);
   return res;
 }

@@ -22,9 +22,9 @@ namespace {
 
 using fesd::MpccMode;
 
-constexpr MpccMode kAllModes[] = {MpccMode::ScholtesIneq, MpccMode::ScholtesEq,
+constexpr MpccMode kAllModes[] = {MpccMode::ScholtesIneq,      MpccMode::ScholtesEq,
                                   MpccMode::FischerBurmeister, MpccMode::L1Penalty,
-                                  MpccMode::ElasticIneq};
+                                  MpccMode::ElasticIneq,       MpccMode::ElasticTwoSided};
 
 std::string mode_name(const ::testing::TestParamInfo<MpccMode>& p) {
   return std::string(fesd::to_string(p.param));
@@ -336,6 +336,17 @@ TEST_P(TwoSided, StayScholtesRowsInEveryMode) {
     const int row = relaxation.group_rows()[k];
     double product_sum = 0;
     for (const auto& p : groups[k].pairs) product_sum += nlp.x_init[p.a] * nlp.x_init[p.b];
+    if (mode == MpccMode::ElasticTwoSided) {  // every group: G - s <= 0 (and G + s >= 0)
+      two_sided += groups[k].two_sided ? 1 : 0;
+      ASSERT_GE(row, 0);
+      EXPECT_EQ(nlp.g_lb[row], -fesd::nlp::kInf);
+      EXPECT_EQ(nlp.g_ub[row], 0.0);
+      EXPECT_DOUBLE_EQ(g[row], product_sum - nlp.x_init[relaxation.elastic_variable()]);
+      EXPECT_EQ(nlp.g_lb[row + 1], 0.0);
+      EXPECT_EQ(nlp.g_ub[row + 1], fesd::nlp::kInf);
+      EXPECT_DOUBLE_EQ(g[row + 1], product_sum + nlp.x_init[relaxation.elastic_variable()]);
+      continue;
+    }
     if (groups[k].two_sided) {
       ++two_sided;
       ASSERT_GE(row, 0);
@@ -364,6 +375,8 @@ TEST_P(TwoSided, StayScholtesRowsInEveryMode) {
         EXPECT_EQ(nlp.g_ub[row], 0.0);
         EXPECT_DOUBLE_EQ(g[row], product_sum - nlp.x_init[relaxation.elastic_variable()]);
         break;
+      case MpccMode::ElasticTwoSided:
+        break;  // above
     }
   }
   EXPECT_EQ(two_sided, 3 * 2 * 2);
@@ -375,7 +388,8 @@ TEST_P(TwoSided, StayScholtesRowsInEveryMode) {
   } else {
     EXPECT_EQ(relaxation.sigma_variable(), -1);
   }
-  EXPECT_EQ(relaxation.elastic_variable() >= 0, mode == MpccMode::ElasticIneq);
+  EXPECT_EQ(relaxation.elastic_variable() >= 0,
+            mode == MpccMode::ElasticIneq || mode == MpccMode::ElasticTwoSided);
 }
 INSTANTIATE_TEST_SUITE_P(Modes, TwoSided, ::testing::ValuesIn(kAllModes), mode_name);
 

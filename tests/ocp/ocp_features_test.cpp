@@ -1,0 +1,290 @@
+// OCP modelling features of nosnoc (issue "every nosnoc_py example", second slice): global decision
+// variables (OcpData::v_global, [ocp] v_global), time-optimal problems with a speed of time
+// (time_optimal_problem), path complementarity constraints (g_path_comp) and the two-sided elastic
+// MPCC mode (mpcc_mode = elastic_two_sided), each against a problem with a known answer
+// (examples/ocp_global_variable.toml, ocp_time_optimal.toml, ocp_path_complementarity.toml, the
+// sensitivity OCP (56) and the sliding-mode OCP of Sect. 5.3). docs/ocp-features.md.
+#include <cmath>
+#include <string>
+
+#include <fstream>
+#include <iterator>
+
+#include <gtest/gtest.h>
+#include <Eigen/Dense>
+#include <fesd/error.hpp>
+#include <fesd/io.hpp>
+#include <fesd/ocp.hpp>
+#include <fesd/problem_file.hpp>
+#include <nlohmann/json.hpp>
+
+#include "support/temp_dir.hpp"
+
+#include "../../bench/sensitivity_ocp.hpp"
+
+namespace fesd {
+namespace {
+
+OcpProblem example(const std::string& name) {
+  return load_ocp_problem(std::string(FESD_SOURCE_DIR) + "/examples/" + name);
+}
+
+// ---- global decision variables -----------------------------------------------------------------
+
+// a* = (1 + sqrt 5) / 2 reaches x(2) = 1 (objective 0); the crossing at 1 / (a* + 1). The
+// trajectory is piecewise linear, so the scheme is exact once the crossing is an element boundary:
+// measured |a - a*| ~ 1e-9 (the Mayer term's gradient vanishes at the optimum, so a is as
+// accurate as IPOPT's tolerance allows: 1e-6).
+TEST(OcpGlobalVariable, ParameterReachesTheGoldenRatio) {
+  const OcpProblem p = example("ocp_global_variable.toml");
+  ASSERT_EQ(p.ocp.v_global.size(), 1u);
+  EXPECT_EQ(p.ocp.v_global[0].index, 0);
+  EXPECT_EQ(p.ocp.v_global[0].lb, 1.2);
+  const OcpResult r = solve(p.ocp, p.options);
+  ASSERT_EQ(r.status, Status::Success) << r.message;
+  const double a_star = (1 + std::sqrt(5.0)) / 2;
+  ASSERT_EQ(r.v_global.size(), 1);
+  EXPECT_EQ(r.v_global_names, std::vector<std::string>{"a"});
+  EXPECT_NEAR(r.v_global[0], a_star, 1e-6);
+  EXPECT_NEAR(r.objective, 0.0, 1e-10);
+  EXPECT_NEAR(r.x_final()[0], 1.0, 1e-6);
+  ASSERT_EQ(r.switches.size(), 1u);
+  EXPECT_NEAR(r.switches[0].t, 1 / (a_star + 1), 1e-6);
+  EXPECT_NE(r.brief_report().find("a = 1.618"), std::string::npos) << r.brief_report();
+}
+
+// With ub = 1.5 the bound is active: x(2) = 0.5 * 4 / 2.5 = 0.8, objective 0.04 (exact to the
+// scheme: 1e-8).
+TEST(OcpGlobalVariable, UpperBoundIsActive) {
+  OcpProblem p = example("ocp_global_variable.toml");
+  p.ocp.v_global[0].ub = 1.5;
+  p.ocp.p[0] = 1.4;
+  const OcpResult r = solve(p.ocp, p.options);
+  ASSERT_EQ(r.status, Status::Success) << r.message;
+  EXPECT_NEAR(r.v_global[0], 1.5, 1e-8);
+  EXPECT_NEAR(r.x_final()[0], 0.8, 1e-8);
+  EXPECT_NEAR(r.objective, 0.04, 1e-8);
+}
+
+// Time-varying parameters next to a global one: the global one is one variable for every
+// interval (a per interval would reach x(2) = 1 in many ways; one a only in one).
+TEST(OcpGlobalVariable, OneValueForEveryInterval) {
+  OcpProblem p = example("ocp_global_variable.toml");
+  p.ocp.N_stages = 2;
+  p.ocp.p_stage = {Eigen::VectorXd::Constant(1, 2.0), Eigen::VectorXd::Constant(1, 2.5)};
+  const OcpResult r = solve(p.ocp, p.options);
+  ASSERT_EQ(r.status, Status::Success) << r.message;
+  EXPECT_NEAR(r.v_global[0], (1 + std::sqrt(5.0)) / 2, 1e-6);
+}
+
+TEST(OcpGlobalVariable, BadInput) {
+  OcpProblem p = example("ocp_global_variable.toml");
+  p.ocp.v_global[0].index = 3;
+  EXPECT_THROW(
+      {
+        try {
+          solve(p.ocp, p.options);
+        } catch (const InvalidModel& e) {
+          EXPECT_NE(std::string(e.what()).find("ocp.v_global[0].index = 3: not a parameter"),
+                    std::string::npos)
+              << e.what();
+          throw;
+        }
+      },
+      InvalidModel);
+  p = example("ocp_global_variable.toml");
+  p.ocp.p[0] = 5;  // the guess
+  EXPECT_THROW(solve(p.ocp, p.options), InvalidModel);
+  p = example("ocp_global_variable.toml");
+  p.ocp.v_global.push_back(p.ocp.v_global[0]);
+  EXPECT_THROW(solve(p.ocp, p.options), InvalidModel);
+}
+
+// ---- time-optimal problems ---------------------------------------------------------------------
+
+// x' in 2 - sign(x) + u from -1 to 1 with |u| <= 1: T* = 3/4 with u = 1, crossing at t = 1/4
+// (physical time). Piecewise linear: exact up to IPOPT's tolerance (measured ~1e-10; 1e-7).
+TEST(OcpTimeOptimal, SwitchedSystemReachesTheMinimalTime) {
+  const OcpProblem p = example("ocp_time_optimal.toml");
+  EXPECT_TRUE(p.ocp.time_optimal_problem);
+  const OcpResult r = solve(p.ocp, p.options);
+  ASSERT_EQ(r.status, Status::Success) << r.message;
+  EXPECT_NEAR(r.T_final, 0.75, 1e-7);
+  ASSERT_EQ(r.s_sot.size(), 1u);  // one per control interval
+  EXPECT_NEAR(r.s_sot[0], 0.75, 1e-7);
+  EXPECT_NEAR(r.objective, 0.75, 1e-7);
+  EXPECT_NEAR(r.u[0][0], 1.0, 1e-6);
+  EXPECT_NEAR(r.t.back(), r.T_final, 1e-12);
+  EXPECT_NEAR(r.t_ctrl.back(), r.T_final, 1e-12);
+  EXPECT_NEAR(r.x_final()[0], 1.0, 1e-8);
+  ASSERT_EQ(r.switches.size(), 1u);
+  EXPECT_NEAR(r.switches[0].t, 0.25, 1e-7);
+  double sum_h = 0;
+  for (double h : r.h) sum_h += h;
+  EXPECT_NEAR(sum_h, r.T_final, 1e-12);
+}
+
+/// x1' = x2, x2' = u (one region; the switching function x2 + 100 is never reached).
+struct DoubleIntegrator {
+  template <class T>
+  void c(const T* x, const T*, T* out) const {
+    out[0] = x[1] + 100.0;
+  }
+  template <class T>
+  void f(int, const T* x, const T* u, const T*, T* out) const {
+    out[0] = x[1];
+    out[1] = u[0];
+  }
+};
+/// Rest to rest over the distance 1: x(T) = (1, 0).
+struct RestToRest {
+  template <class T>
+  void g_terminal(const T* x, const T*, T* out) const {
+    out[0] = x[0] - 1.0;
+    out[1] = x[1];
+  }
+};
+
+Ocp double_integrator(bool local) {
+  Ocp ocp;
+  ocp.model = make_pss(DoubleIntegrator{}, PssDims{2, 1, 0, {Subsystem::from_c(1)}});
+  ocp.functions = make_ocp_functions(RestToRest{});
+  ocp.T = 1;
+  ocp.N_stages = 2;
+  ocp.x0 = Eigen::Vector2d(0, 0);
+  ocp.lbu = Eigen::VectorXd::Constant(1, -1);
+  ocp.ubu = Eigen::VectorXd::Constant(1, 1);
+  ocp.u_guess_stage = {Eigen::VectorXd::Constant(1, 0.5), Eigen::VectorXd::Constant(1, -0.5)};
+  ocp.n_g_terminal = 2;
+  ocp.lbg_terminal = ocp.ubg_terminal = Eigen::Vector2d::Zero();
+  ocp.time_optimal_problem = true;
+  ocp.local_speed_of_time_variable = local;
+  return ocp;
+}
+
+// Rest to rest over d = 1 with |u| <= 1: bang-bang, T* = 2 sqrt(d) = 2, u = (1, -1), with one
+// speed for the horizon or one per control interval (then s = (2, 2)). Quadratic trajectories:
+// Radau IIA with n_s = 2 is exact (measured ~1e-10; 1e-7).
+TEST(OcpTimeOptimal, DoubleIntegratorRestToRest) {
+  OcpOptions o;
+  o.discretization.N_FE = 2;
+  for (bool local : {false, true}) {
+    const OcpResult r = solve(double_integrator(local), o);
+    ASSERT_EQ(r.status, Status::Success) << r.message;
+    EXPECT_NEAR(r.T_final, 2.0, 1e-7) << "local " << local;
+    EXPECT_NEAR(r.objective, 2.0, 1e-7);
+    ASSERT_EQ(r.s_sot.size(), 2u);  // per control interval (equal with one global speed)
+    for (double s : r.s_sot) EXPECT_NEAR(s, 2.0, 1e-6);
+    EXPECT_NEAR(r.u[0][0], 1.0, 1e-6);
+    EXPECT_NEAR(r.u[1][0], -1.0, 1e-6);
+    EXPECT_NEAR(r.t_ctrl[1], 1.0, 1e-6);
+    EXPECT_NEAR(r.x.back()[0], 1.0, 1e-8);
+  }
+}
+
+TEST(OcpTimeOptimal, BadInput) {
+  Ocp ocp = double_integrator(false);
+  ocp.s_sot0 = 50;  // above s_sot_max = 25
+  EXPECT_THROW(solve(ocp, OcpOptions{}), InvalidOption);
+  ocp = double_integrator(false);
+  ocp.s_sot_min = 0;
+  EXPECT_THROW(solve(ocp, OcpOptions{}), InvalidOption);
+}
+
+// The JSON result names the new values: T_final, s_sot, v_global (name = value).
+TEST(OcpFeaturesJson, FinalTimeAndGlobalVariables) {
+  testing::TempDir dir;
+  const auto read = [](const std::string& path) {
+    std::ifstream in(path);
+    return nlohmann::ordered_json::parse(
+        std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()));
+  };
+  const OcpProblem t = example("ocp_time_optimal.toml");
+  write_json(solve(t.ocp, t.options), t.ocp.model, dir.file("t.json"));
+  const auto jt = read(dir.file("t.json"));
+  EXPECT_NEAR(jt["T_final"].get<double>(), 0.75, 1e-7);
+  ASSERT_EQ(jt["s_sot"].size(), 1u);
+  EXPECT_FALSE(jt.contains("v_global"));
+  const OcpProblem g = example("ocp_global_variable.toml");
+  write_json(solve(g.ocp, g.options), g.ocp.model, dir.file("g.json"));
+  const auto jg = read(dir.file("g.json"));
+  EXPECT_NEAR(jg["v_global"]["a"].get<double>(), (1 + std::sqrt(5.0)) / 2, 1e-6);
+  EXPECT_EQ(jg["T_final"].get<double>(), 2.0);
+  EXPECT_FALSE(jg.contains("s_sot"));
+}
+
+// ---- path complementarity ----------------------------------------------------------------------
+
+// 0 <= x perp u >= 0 leaves one feasible control, u = (0, 1): objective 1 (constant controls,
+// exact quadrature; measured ~1e-9, tolerance 1e-6 from the relaxation's sigma_N).
+TEST(OcpPathComplementarity, SelectsTheKnownOptimum) {
+  const OcpProblem p = example("ocp_path_complementarity.toml");
+  EXPECT_EQ(p.ocp.n_g_path_comp, 1);
+  const OcpResult r = solve(p.ocp, p.options);
+  ASSERT_EQ(r.status, Status::Success) << r.message;
+  EXPECT_NEAR(r.objective, 1.0, 1e-6);
+  EXPECT_NEAR(r.u[0][0], 0.0, 1e-6);
+  EXPECT_NEAR(r.u[1][0], 1.0, 1e-6);
+  for (const Eigen::VectorXd& x : r.x) EXPECT_GE(x[0], -1e-8);
+  EXPECT_NEAR(r.x_final()[0], 0.0, 1e-6);
+  EXPECT_LE(r.comp_residual, p.options.homotopy.complementarity_tol);
+}
+
+// Without the pairs the cheapest control is u = 0 (x drains below 0): objective 0.
+TEST(OcpPathComplementarity, WithoutThePairsTheOptimumDiffers) {
+  OcpProblem p = example("ocp_path_complementarity.toml");
+  p.ocp.n_g_path_comp = 0;
+  const OcpResult r = solve(p.ocp, p.options);
+  ASSERT_EQ(r.status, Status::Success) << r.message;
+  EXPECT_NEAR(r.objective, 0.0, 1e-8);
+}
+
+// The pairs are relaxed like FESD's own complementarity constraints, in every MPCC method.
+class OcpPathComplementarityModes : public ::testing::TestWithParam<MpccMode> {};
+TEST_P(OcpPathComplementarityModes, SameOptimum) {
+  OcpProblem p = example("ocp_path_complementarity.toml");
+  p.options.homotopy.mpcc_mode = GetParam();
+  const OcpResult r = solve(p.ocp, p.options);
+  ASSERT_EQ(r.status, Status::Success) << r.message;
+  EXPECT_NEAR(r.objective, 1.0, 1e-5);
+  EXPECT_NEAR(r.u[1][0], 1.0, 1e-5);
+}
+INSTANTIATE_TEST_SUITE_P(Modes, OcpPathComplementarityModes,
+                         ::testing::Values(MpccMode::ScholtesIneq, MpccMode::ElasticIneq,
+                                           MpccMode::ElasticTwoSided, MpccMode::L1Penalty));
+
+// ---- elastic_two_sided -------------------------------------------------------------------------
+
+// The sensitivity OCP (56) (examples/ocp_sensitivity.toml with the homotopy ending at 1e-9) reaches
+// x0* = (9 - sqrt 417) / 8 from guesses on both sides of it (tolerance 1e-6 as for the other
+// methods, tests/ocp/sensitivity_ocp_test.cpp; measured 1e-11).
+class OcpElasticTwoSided : public ::testing::TestWithParam<double> {};
+TEST_P(OcpElasticTwoSided, SensitivityOcpReachesTheMinimizer) {
+  OcpProblem q = example("ocp_sensitivity.toml");
+  q.ocp.x0[0] = GetParam();
+  q.options.homotopy.mpcc_mode = MpccMode::ElasticTwoSided;
+  q.options.homotopy.sigma_N = 1e-9;
+  q.options.homotopy.complementarity_tol = 1e-9;
+  const OcpResult r = solve(q.ocp, q.options);
+  ASSERT_EQ(r.status, Status::Success) << r.message;
+  EXPECT_EQ(r.mpcc_mode, MpccMode::ElasticTwoSided);
+  EXPECT_NEAR(r.x0()[0], fesd_bench::kSensitivityX0Star, 1e-6);
+  EXPECT_NEAR(r.objective, fesd_bench::kSensitivityVStar, 1e-6);
+}
+INSTANTIATE_TEST_SUITE_P(Guesses, OcpElasticTwoSided, ::testing::Values(-2.7, -1.0, -0.6));
+
+// The sliding-mode OCP of Sect. 5.3 (nosnoc_py's settings): the objective of the default method
+// to the homotopy's tolerance.
+TEST(OcpElasticTwoSidedSliding, SameObjectiveAsTheDefault) {
+  OcpProblem q = example("ocp_sliding_mode_nosnoc.toml");
+  const OcpResult def = solve(q.ocp, q.options);
+  q.options.homotopy.mpcc_mode = MpccMode::ElasticTwoSided;
+  const OcpResult r = solve(q.ocp, q.options);
+  ASSERT_EQ(def.status, Status::Success) << def.message;
+  ASSERT_EQ(r.status, Status::Success) << r.message;
+  EXPECT_NEAR(r.objective, def.objective, 1e-6);
+  EXPECT_EQ(r.switches.size(), def.switches.size());
+}
+
+}  // namespace
+}  // namespace fesd
