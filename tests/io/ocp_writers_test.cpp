@@ -111,6 +111,7 @@ TEST(WriteOcpJson, KeysInOrderAndValues) {
                                             "switch_times",
                                             "x0",
                                             "x_final",
+                                            "T_final",
                                             "homotopy",
                                             "stats",
                                             "t_stage",
