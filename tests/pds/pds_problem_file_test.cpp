@@ -343,6 +343,24 @@ TEST(PdsOcpProblemFile, Wall) {
   EXPECT_NEAR(r.x_final()[0], 0.0, 1e-6);
 }
 
+// initialization = simulation (docs/pds.md): the guess is a simulation of every control interval
+// with u_guess = -1, which reaches the wall in the second interval (contact in the guess); the
+// solution is the one of the constant guess.
+TEST(PdsOcpProblemFile, WallFromSimulation) {
+  fesd::PdsOcpProblem q = fesd::parse_pds_ocp_problem(kWall, "f.toml");
+  const fesd::OcpResult constant = fesd::solve(q.ocp, q.options);
+  fesd::apply_override(q, "initialization", "simulation");
+  fesd::apply_override(q, "u_guess", "-1");
+  const fesd::OcpResult r = fesd::solve(q.ocp, q.options);
+  ASSERT_EQ(constant.status, fesd::Status::Success) << constant.message;
+  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+  for (const std::string& w : r.summary.warnings)
+    EXPECT_EQ(w.find("initialization"), std::string::npos) << w;
+  EXPECT_LE(r.comp_residual, 1e-9);
+  EXPECT_NEAR(r.objective, constant.objective, 1e-6);
+  EXPECT_NEAR(r.x_final()[0], 0.0, 1e-6);
+}
+
 // examples/ocp_pds_discs.toml is the problem of bench/pds_discs_model.hpp (solved in
 // tests/pds/pds_ocp_test.cpp).
 TEST(PdsOcpProblemFile, DiscsExampleReads) {
