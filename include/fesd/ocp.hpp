@@ -247,8 +247,9 @@ OcpResult solve(const Ocp& ocp, const OcpOptions& options);
 /// fixed (HomotopyOptions::fix_active_set). The result: `lambda` holds the PDS multipliers (n_c
 /// per stage), `theta` and `eta` stay empty, `active_set` lists the active constraints per
 /// element, `switches` are contact and leaving events. Not used for PDS: the Stewart-specific
-/// post-processing (sliding-exit pins, the allocation search, active_set_sigma) and
-/// initialization = simulation (the guess is x0 everywhere). Throws like solve(const Ocp&, ...).
+/// post-processing (sliding-exit pins, the allocation search, active_set_sigma).
+/// initialization = simulation integrates each control interval with its u_guess (docs/pds.md).
+/// Throws like solve(const Ocp&, ...).
 OcpResult solve(const PdsOcp& ocp, const OcpOptions& options);
 
 namespace detail {

@@ -155,12 +155,13 @@ struct PdsOptions {
 /// Simulates the PDS from x0 over [0, T_sim] with N_sim steps of N_FE finite elements each: the
 /// standard RK discretization (6) (use_fesd = false) or FESD with cross complementarity (8) and
 /// the step equilibration of Sect. III-C (docs/pds.md). Schemes with c_{n_s} = 1 only: Radau IIA
-/// (FESD with every n_s; n_s = 1 with extended backward sums), Lobatto IIIC with the standard
-/// method only (docs/pds.md). Every step is solved by the MPCC homotopy (step_solver is not used:
-/// the active-set path is specific to Stewart's DCS). Result: lambda holds the PDS multipliers (n_c
-/// per stage), theta and mu stay empty, active_set lists the active constraints of each element
-/// (sum over its stages of lambda_k > sum of c_k), switches are contact and leaving events. Bad
-/// input (sizes, NaN, x0 outside C, options, schemes) throws fesd::Error.
+/// (FESD with every n_s; n_s = 1 with extended backward sums) and Lobatto IIIC (n_s >= 2; with
+/// FESD its first stage, no trajectory point, has c without sign condition, docs/pds.md). Every
+/// step is solved by the MPCC homotopy (step_solver is not used: the active-set path is specific to
+/// Stewart's DCS). Result: lambda holds the PDS multipliers (n_c per stage), theta and mu stay
+/// empty, active_set lists the active constraints of each element (sum over its stages of lambda_k
+/// > sum of c_k), switches are contact and leaving events. Bad input (sizes, NaN, x0 outside C,
+/// options, schemes) throws fesd::Error.
 IntegratorResult integrate(const Pds& model, const Eigen::VectorXd& x0, double T_sim, int N_sim,
                            const IntegratorOptions& options = {}, const Eigen::VectorXd& u = {},
                            const Eigen::VectorXd& p = {}, const PdsOptions& pds = {});

@@ -59,9 +59,9 @@ PdsOcpProblem parse_pds_ocp_problem(std::string_view toml_text, std::string_view
 
 /// Overrides one option of a projected file as if it had been written in the file (`fesd
 /// simulate/solve FILE --key value`): the registry options of its kind ([simulation] or [ocp],
-/// [discretization], [homotopy]), [ipopt] keys, model.x0, simulation.u / ocp.u_guess. Not yet:
-/// model.p, tol_sim, t0. Throws fesd::InvalidOption naming the key; on error the problem is
-/// unchanged.
+/// [discretization], [homotopy]), [ipopt] keys, model.x0, model.p ("NAME=VALUE"), simulation.u /
+/// ocp.u_guess. Not yet: tol_sim, t0. Throws fesd::InvalidOption naming the key; on error the
+/// problem is unchanged.
 void apply_override(PdsSimulationProblem& problem, std::string_view key, std::string_view value);
 void apply_override(PdsOcpProblem& problem, std::string_view key, std::string_view value);
 /// Several overrides, retried in the order fesd::apply_overrides (problem_file.hpp) uses.

@@ -493,8 +493,11 @@ struct SolveArgs {
   Overrides overrides;
 };
 
+int run_check_pds(const std::string& file, const Overrides& overrides);
+
 int run_check(const std::string& file, const Overrides& overrides) {
   check_input_file(file);
+  if (fesd::is_projected_problem_file(file)) return run_check_pds(file, overrides);
   // The header, then the model as read: every region's sign pattern and vector field.
   if (fesd::problem_file_kind(file) == fesd::ProblemKind::Ocp) {
     const auto problem = load<fesd::OcpProblem>(file, overrides);
@@ -597,7 +600,6 @@ Problem prepare(const SolveArgs& args, const CLI::App& cmd) {
   return problem;
 }
 
-
 /// The first lines of the header of a projected file: name, source, what it is, sizes,
 /// description, x0 and the scheme.
 template <class Problem>
@@ -611,6 +613,36 @@ void print_pds_header(const Problem& problem, std::string_view what, const std::
              d.n_s, d.N_FE, yes_no(d.use_fesd));
 }
 
+void print_header(const fesd::PdsSimulationProblem& problem) {
+  print_pds_header(problem, "projected dynamical system",
+                   fmt::format("n_c = {}", problem.model.n_c()), problem.model, problem.x0,
+                   problem.options.discretization);
+  out::print("  simulation  T_sim = {:g}, N_sim = {}\n", problem.T_sim, problem.N_sim);
+}
+
+void print_header(const fesd::PdsOcpProblem& problem) {
+  const fesd::PdsOcp& ocp = problem.ocp;
+  print_pds_header(problem, "optimal control of a projected dynamical system",
+                   fmt::format("n_u = {}, n_c = {}", ocp.model.n_u(), ocp.model.n_c()), ocp.model,
+                   ocp.x0, problem.options.discretization);
+  out::print("  ocp         T = {:g}, N_stages = {}\n", ocp.T, ocp.N_stages);
+}
+
+/// `fesd check` of a projected file: the header and the model as read (docs/pds.md).
+int run_check_pds(const std::string& file, const Overrides& overrides) {
+  auto run = [&](auto problem) {
+    fesd::apply_overrides(problem, overrides.pairs());
+    print_header(problem);
+    out::print("{}", fesd::io_detail::describe(problem));
+  };
+  if (fesd::problem_file_kind(file) == fesd::ProblemKind::Ocp)
+    run(fesd::load_pds_ocp_problem(file));
+  else
+    run(fesd::load_pds_simulation_problem(file));
+  out::print("check: '{}' is valid (nothing was solved)\n", file);
+  return kExitSolved;
+}
+
 /// `fesd simulate` of a projected dynamical system ([model] kind = "projected", docs/pds.md): the
 /// header, integrate() and the report; --json and --csv as for piecewise smooth models.
 int run_simulate_pds(const SolveArgs& args, const CLI::App& cmd) {
@@ -618,10 +650,8 @@ int run_simulate_pds(const SolveArgs& args, const CLI::App& cmd) {
   fesd::PdsSimulationProblem problem = fesd::load_pds_simulation_problem(args.file);
   fesd::apply_overrides(problem, args.overrides.pairs());
   if (!args.quiet) {
-    print_pds_header(problem, "projected dynamical system",
-                     fmt::format("n_c = {}", problem.model.n_c()), problem.model, problem.x0,
-                     problem.options.discretization);
-    out::print("  simulation  T_sim = {:g}, N_sim = {}\n\n", problem.T_sim, problem.N_sim);
+    print_header(problem);
+    out::print("\n");
     flush_stdout();
   }
   const fesd::IntegratorResult result = fesd::simulate(problem);
@@ -655,10 +685,8 @@ int run_solve_pds(const SolveArgs& args, const CLI::App& cmd) {
   fesd::apply_overrides(problem, args.overrides.pairs());
   const fesd::PdsOcp& ocp = problem.ocp;
   if (!args.quiet) {
-    print_pds_header(problem, "optimal control of a projected dynamical system",
-                     fmt::format("n_u = {}, n_c = {}", ocp.model.n_u(), ocp.model.n_c()), ocp.model,
-                     ocp.x0, problem.options.discretization);
-    out::print("  ocp         T = {:g}, N_stages = {}\n\n", ocp.T, ocp.N_stages);
+    print_header(problem);
+    out::print("\n");
     flush_stdout();
     show_progress(problem.options);
   }

@@ -92,12 +92,6 @@ std::vector<std::string> PdsInterval::errors(const Tableau& tab, const Discretiz
         "rk_scheme = {}: projected dynamical systems support only schemes with c_n_s = 1 whose "
         "last stage is the element end (radau_iia, lobatto_iiic), papers/fesd-pds.txt Sect. III-A",
         to_string(tab.scheme)));
-  if (o.use_fesd && tab.scheme == RkScheme::LobattoIIIC)
-    e.push_back(
-        "rk_scheme = lobatto_iiic with use_fesd: its first stage (c_1 = 0) is not a point of "
-        "the trajectory, and where the state leaves the boundary of C, (8a) sets lambda = 0 "
-        "there while c(x_{n,1}) < 0 (measured on Example 1: the homotopy stalls at a residual of "
-        "5e-6); use radau_iia, or use_fesd = false");
   if (o.use_fesd && o.N_FE < 2)
     e.push_back(fmt::format("N_finite_elements = {}: FESD needs >= 2", o.N_FE));
   if (!(pds.M > 0) || !std::isfinite(pds.M))
@@ -111,6 +105,7 @@ PdsInterval::PdsInterval(const Pds& model, const Tableau& tableau,
   if (auto e = errors(tab_, opt_, pds_); !e.empty()) throw InvalidOption(registry::join(e));
   N_FE_ = opt_.N_FE;
   n_s_ = tab_.n_s;
+  free_first_ = opt_.use_fesd && tab_.scheme == RkScheme::LobattoIIIC;
 }
 
 void PdsInterval::build(nlp::BlockNlp& nlp, const PdsIntervalInputs& in) {
@@ -134,7 +129,7 @@ void PdsInterval::build(nlp::BlockNlp& nlp, const PdsIntervalInputs& in) {
       X_.push_back(nlp.add_variables(n_x, -kInf, kInf, 0.0));
       V_.push_back(nlp.add_variables(n_x, -kInf, kInf, 0.0));
       lambda_.push_back(nlp.add_variables(n_c, 0.0, kInf, 0.0));
-      C_.push_back(nlp.add_variables(n_c, 0.0, kInf, 0.0));
+      C_.push_back(nlp.add_variables(n_c, i == 0 && free_first_ ? -kInf : 0.0, kInf, 0.0));
     }
   }
   // ---- (6a), (6b) ----
@@ -186,9 +181,10 @@ void PdsInterval::build(nlp::BlockNlp& nlp, const PdsIntervalInputs& in) {
     auto row = [&](std::vector<int> vars, std::vector<double> a, double lb, double ub) {
       nlp.add_constraint(nlp::make_block(LinearEq{std::move(a)}), std::move(vars), lb, ub);
     };
-    // n_s = 1: c at the step start (the backward sum of boundary 1, see backward_extra).
+    // n_s = 1: c at the step start (the backward sum of boundary 1, see backward_extra); Lobatto
+    // IIIC: c at the start point of element 0 (sums (10), the pairs of (8b) for n = 0).
     C0_.clear();
-    if (n_s_ == 1) {
+    if (n_s_ == 1 || free_first_) {
       const int c0 = nlp.add_variables(n_c, -kInf, kInf, 0.0);
       std::vector<int> cv = range(c0, n_c);
       cv.insert(cv.end(), in.s0.begin(), in.s0.end());
@@ -200,23 +196,19 @@ void PdsInterval::build(nlp::BlockNlp& nlp, const PdsIntervalInputs& in) {
     for (int n = 1; n < N_FE_; ++n) {
       for (int k = 0; k < n_c; ++k) {
         auto sum_vars = [&](int e, bool of_lambda) {
-          std::vector<int> v;
-          for (int i = 0; i < n_s_; ++i) v.push_back(of_lambda ? lambda(e, i, k) : C(e, i, k));
-          return v;
+          return of_lambda ? lambda_terms(e, k) : c_terms(e, k);
         };
-        const std::vector<double> ones(n_s_, -1.0);
         // pi = sigma^B or sigma^F:  pi >= sigma^B, pi >= sigma^F, pi <= sigma^B + sigma^F (10)
         for (int which = 0; which < 2; ++which) {
           const bool of_lambda = which == 1;
           const int pi = nlp.add_variables(1, 0.0, kInf, 0.0);
           (of_lambda ? pi_l_ : pi_c_)[n][k] = pi;
           std::vector<int> vb{pi}, vf{pi}, vbf{pi};
-          std::vector<double> a{1.0};
-          for (int var : sum_vars(n - 1, of_lambda)) vb.push_back(var), vbf.push_back(var);
-          for (int var : sum_vars(n, of_lambda)) vf.push_back(var), vbf.push_back(var);
-          a.insert(a.end(), ones.begin(), ones.end());
-          std::vector<double> ab = a, abf = a;
-          abf.insert(abf.end(), ones.begin(), ones.end());
+          std::vector<double> ab{1.0}, af{1.0}, abf{1.0};
+          for (int var : sum_vars(n - 1, of_lambda))
+            vb.push_back(var), vbf.push_back(var), ab.push_back(-1.0), abf.push_back(-1.0);
+          for (int var : sum_vars(n, of_lambda))
+            vf.push_back(var), vbf.push_back(var), af.push_back(-1.0), abf.push_back(-1.0);
           if (const int extra = backward_extra(n, k, of_lambda); extra >= 0) {
             vb.push_back(extra);
             ab.push_back(-1.0);
@@ -224,7 +216,7 @@ void PdsInterval::build(nlp::BlockNlp& nlp, const PdsIntervalInputs& in) {
             abf.push_back(-1.0);
           }
           row(vb, ab, 0.0, kInf);
-          row(vf, a, 0.0, kInf);
+          row(vf, af, 0.0, kInf);
           row(vbf, abf, -kInf, 0.0);
         }
         // nu_k = pi_c and pi_lambda: nu <= pi_c, nu <= pi_lambda, nu >= pi_c + pi_lambda - max,
@@ -278,11 +270,33 @@ void PdsInterval::build(nlp::BlockNlp& nlp, const PdsIntervalInputs& in) {
     else
       by_c[c_var].pairs.push_back(pair);
   };
+  std::vector<CompGroup> two_sided;
   for (int n = 0; n < N_FE_; ++n)
     for (int k = 0; k < n_c; ++k)
       for (int i = 0; i < n_s_; ++i) {
         if (!fesd) {
           add(C(n, i, k), lambda(n, i, k));  // (6b)
+          continue;
+        }
+        if (i == 0 && free_first_) {
+          // Lobatto IIIC: stage 1 is no trajectory point (c_1 = 0, X_{n,1} != x_n), so
+          // c(X_{n,1}) has no sign condition: its pairs (8a), (8c) are relaxed on both sides
+          // (c(X_{n,1}) = 0 where a lambda of the element or lambda_{n-1,n_s} is positive, free in
+          // a free element). lambda_{n,1} keeps its sign and its pairs with the other stages and
+          // with the start point x_n ((8b); for n = 0 c(s0), also without sign).
+          CompGroup own{{}, /*two_sided=*/true};
+          for (int j = 0; j < n_s_; ++j) own.pairs.push_back({C(n, 0, k), lambda(n, j, k)});
+          if (n >= 1) {
+            own.pairs.push_back({C(n, 0, k), lambda(n - 1, n_s_ - 1, k)});  // (8c)
+            add(C(n - 1, n_s_ - 1, k), lambda(n, 0, k));                    // (8b)
+          }
+          if (n == 0)
+            for (int j = 0; j < n_s_; ++j) own.pairs.push_back({C0_[k], lambda(0, j, k)});
+          for (const CompPair& pair : own.pairs) {
+            residual_pairs_.push_back(pair);
+            if (opt_.cross_comp == CrossComp::Sparse) two_sided.push_back({{pair}, true});
+          }
+          if (opt_.cross_comp != CrossComp::Sparse) two_sided.push_back(std::move(own));
           continue;
         }
         for (int j = 0; j < n_s_; ++j) add(C(n, i, k), lambda(n, j, k));  // (8a)
@@ -292,6 +306,7 @@ void PdsInterval::build(nlp::BlockNlp& nlp, const PdsIntervalInputs& in) {
         }
       }
   for (auto& [var, g] : by_c) groups_.push_back(std::move(g));
+  for (CompGroup& g : two_sided) groups_.push_back(std::move(g));
   for (const CompPair& pair : lp_pairs) {
     residual_pairs_.push_back(pair);
     groups_.push_back({{pair}});
@@ -320,7 +335,7 @@ void PdsInterval::set_guess(std::vector<double>& w, const Eigen::VectorXd& x0,
       }
       for (int k = 0; k < n_c; ++k) {
         w[lambda(n, i, k)] = std::max(lg[k], 0.0);
-        w[C(n, i, k)] = std::max(c[k], 0.0);
+        w[C(n, i, k)] = i == 0 && free_first_ ? c[k] : std::max(c[k], 0.0);
       }
     }
   }
@@ -335,10 +350,10 @@ void PdsInterval::set_guess(std::vector<double>& w, const Eigen::VectorXd& x0,
     double nu_max = 0;
     for (int k = 0; k < n_c; ++k) {
       double cb = 0, cf = 0, lb = 0, lf = 0;
-      for (int i = 0; i < n_s_; ++i) {
-        cb += w[C(n - 1, i, k)], cf += w[C(n, i, k)];
-        lb += w[lambda(n - 1, i, k)], lf += w[lambda(n, i, k)];
-      }
+      for (int v : c_terms(n - 1, k)) cb += w[v];
+      for (int v : c_terms(n, k)) cf += w[v];
+      for (int v : lambda_terms(n - 1, k)) lb += w[v];
+      for (int v : lambda_terms(n, k)) lf += w[v];
       if (const int e = backward_extra(n, k, false); e >= 0) cb += w[e];
       if (const int e = backward_extra(n, k, true); e >= 0) lb += w[e];
       const double pc = std::max(cb, cf), pl = std::max(lb, lf), mx = std::max(pc, pl);
@@ -356,6 +371,19 @@ void PdsInterval::set_guess(std::vector<double>& w, const Eigen::VectorXd& x0,
   }
 }
 
+std::vector<int> PdsInterval::c_terms(int e, int k) const {
+  std::vector<int> v;
+  if (free_first_) v.push_back(e == 0 ? C0_[k] : C(e - 1, n_s_ - 1, k));
+  for (int i = free_first_ ? 1 : 0; i < n_s_; ++i) v.push_back(C(e, i, k));
+  return v;
+}
+
+std::vector<int> PdsInterval::lambda_terms(int e, int k) const {
+  std::vector<int> v;
+  for (int i = 0; i < n_s_; ++i) v.push_back(lambda(e, i, k));
+  return v;
+}
+
 int PdsInterval::backward_extra(int n, int k, bool of_lambda) const {
   if (n_s_ != 1 || n < 1) return -1;
   if (n >= 2) return of_lambda ? lambda(n - 2, 0, k) : C(n - 2, 0, k);
@@ -366,7 +394,12 @@ std::vector<int> PdsInterval::active_set(const double* w, int n) const {
   std::vector<int> active;
   for (int k = 0; k < model_.n_c(); ++k) {
     double l = 0, c = 0;
-    for (int i = 0; i < n_s_; ++i) l += w[lambda(n, i, k)], c += w[C(n, i, k)];
+    for (int v : lambda_terms(n, k)) l += w[v];
+    if (free_first_) {
+      for (int v : c_terms(n, k)) c += w[v];
+    } else {
+      for (int i = 0; i < n_s_; ++i) c += w[C(n, i, k)];
+    }
     if (n_s_ == 1 && opt_.use_fesd) {
       if (one_stage_active(w, n, k)) active.push_back(k);
     } else if (l > c) {

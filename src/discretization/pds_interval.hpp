@@ -1,6 +1,6 @@
 // src/discretization/pds_interval.hpp: the equations of one interval [0, T] of a projected
 // dynamical system (include/fesd/pds.hpp) with N_FE finite elements and an n_s-stage RK method
-// with c_{n_s} = 1 (Radau IIA; Lobatto IIIC for the standard method only), papers/fesd-pds.txt
+// with c_{n_s} = 1 (Radau IIA, Lobatto IIIC), papers/fesd-pds.txt
 // Sect. III, written into a BlockNlp (docs/pds.md):
 //
 //   per element n and stage i (lifted stage derivatives V and constraint values C):
@@ -15,6 +15,10 @@
 //   pi_c = sigma_c^B or sigma_c^F, pi_lambda = sigma_lambda^B or sigma_lambda^F,
 //   nu_k = pi_c and pi_lambda (the Boolean operators, max by the KKT conditions of its LP), nu_n =
 //   nu_1 or ... or nu_{n_c}, and -nu_n M <= h_{n-1} - h_n <= nu_n M.
+//
+// Lobatto IIIC with FESD: stage 1 (c_1 = 0 but X_{n,1} != x_n) is no trajectory point: C_{n,1}
+// has no sign condition, its products with the lambdas of the element and lambda_{n-1,n_s} are
+// relaxed on both sides, it is in no sum (10) (c at the start point x_n replaces it there).
 //
 // Unlike Stewart's lambda, the PDS lambda jumps at contact (Prop. 2): there is no lambda at the
 // element start and no continuity condition (27). The complementarity pairs are returned, not
@@ -44,7 +48,7 @@ struct PdsIntervalInputs {
 class PdsInterval {
  public:
   /// Throws fesd::InvalidOption for a scheme without c_{n_s} = 1 and stiff accuracy (only Radau
-  /// IIA and Lobatto IIIC; FESD: Radau IIA only), FESD with N_FE < 2, or M <= 0.
+  /// IIA and Lobatto IIIC), FESD with N_FE < 2, or M <= 0.
   PdsInterval(const Pds& model, const Tableau& tableau, const DiscretizationOptions& options,
               const PdsOptions& pds_options);
 
@@ -103,6 +107,11 @@ class PdsInterval {
   /// at a leaving point lambda > 0 there (contact before); where nothing switches the added term
   /// is 0 exactly when the paper's is (docs/pds.md, "n_s = 1").
   int backward_extra(int n, int k, bool of_lambda) const;
+  /// The terms of the sums (10) over element e (also the rule of active_set): C and lambda of its
+  /// stages; with free_first_ (Lobatto IIIC) c at the element's start point (C of the last stage
+  /// before, C0_ for e = 0) instead of c(X_{e,1}), which is no trajectory point.
+  std::vector<int> c_terms(int e, int k) const;
+  std::vector<int> lambda_terms(int e, int k) const;
   /// n_s = 1 with FESD: whether constraint k is active in element n (the rule of active_set, with
   /// ties continuing the element before).
   bool one_stage_active(const double* w, int n, int k) const;
@@ -113,8 +122,12 @@ class PdsInterval {
   PdsOptions pds_;
   PdsIntervalInputs in_;
   int N_FE_ = 0, n_s_ = 0;
+  /// FESD with Lobatto IIIC: stage 1 (c_1 = 0, X_{n,1} != x_n) is no trajectory point, so
+  /// C_{n,1} = c(X_{n,1}) has no sign condition and only two-sided products (docs/pds.md,
+  /// "Lobatto IIIC").
+  bool free_first_ = false;
   std::vector<int> h_, X_, V_, lambda_, C_;
-  std::vector<int> C0_;  ///< n_s = 1 with FESD: c(s0) (n_c variables), else empty
+  std::vector<int> C0_;  ///< FESD with n_s = 1 or Lobatto IIIC: c(s0) (n_c variables), else empty
   // step equilibration, per boundary n (index n, 0 unused) and constraint k
   std::vector<int> nu_;
   std::vector<std::vector<int>> pi_c_, pi_l_, max_, nu_k_, s1_, s2_, mu1_, mu2_;

@@ -11,6 +11,7 @@
 
 #include "io/ocp_expression_functions.hpp"
 #include "model/expression_model.hpp"
+#include "model/expression_pds.hpp"
 
 namespace fesd::io_detail {
 namespace {
@@ -192,7 +193,7 @@ std::string describe_discretization(const DiscretizationOptions& d) {
                                          d.pin_sliding_exits ? 1 : 0));
 }
 
-std::string describe_ocp_functions(const Ocp& ocp) {
+std::string describe_ocp_functions(const OcpData& ocp) {
   const auto* f = dynamic_cast<const ExpressionOcpFunctions*>(ocp.functions.get());
   if (f == nullptr) return "";
   const OcpExpressions& e = f->expressions();
@@ -227,6 +228,67 @@ std::string describe(const SimulationProblem& problem) {
 std::string describe(const OcpProblem& problem) {
   const std::string functions = describe_ocp_functions(problem.ocp);
   return describe_common(problem.ocp.model, problem.has_clock, problem.options.discretization) +
+         (functions.empty() ? "" : "\ncosts and constraints as read\n" + functions);
+}
+
+std::string describe_model(const Pds& m) {
+  const PdsExpressionView e = expressions_of(m);
+  auto name = [](const std::vector<std::string>& names, int i, const char* prefix) {
+    const auto k = static_cast<std::size_t>(i);
+    return k < names.size() && !names[k].empty() ? names[k] : fmt::format("{}{}", prefix, i + 1);
+  };
+  std::string s;
+  if (m.n_u() > 0) {
+    std::vector<std::string> names;
+    for (int i = 0; i < m.n_u(); ++i) names.push_back(name(m.control_names, i, "u"));
+    s += line("controls", join(names, ", "));
+  }
+  if (m.n_p() > 0) {
+    std::vector<std::string> values;
+    for (int i = 0; i < m.n_p(); ++i)
+      values.push_back(fmt::format("{} = {:g}", name(m.parameter_names, i, "p"),
+                                   i < m.p_default.size() ? m.p_default[i] : 0.0));
+    s += line("parameters", join(values, ", "));
+  }
+  s += wrapped("dynamics",
+               "x' = f(x, u, p) + grad c(x) lambda, 0 <= c(x) perp lambda >= 0 (the projection of "
+               "f onto the tangent cone of C = {x : c(x) >= 0}, (3))");
+  for (int k = 0; k < m.n_c(); ++k) {
+    const auto at = static_cast<std::size_t>(k);
+    const std::string text =
+        e.c != nullptr && at < e.c->size() ? (*e.c)[at].text() : std::string("(given in C++)");
+    s += line(fmt::format("c[{}]", k), text + " >= 0");
+  }
+  if (e.f == nullptr) return s + line("f", "(given in C++)");
+  std::vector<std::string> parts;
+  for (std::size_t i = 0; i < e.f->size(); ++i)
+    parts.push_back(
+        fmt::format("{}' = {}", name(m.state_names, static_cast<int>(i), "x"), (*e.f)[i].text()));
+  const std::string one = join(parts, ",  ");
+  if (kIndent + one.size() <= kLineWidth) return s + line("f", one);
+  s += line("f", parts.front());
+  for (std::size_t i = 1; i < parts.size(); ++i) s += continuation(parts[i]);
+  return s;
+}
+
+std::string describe_discretization(const DiscretizationOptions& d, const PdsOptions& pds) {
+  if (!d.use_fesd) return "";
+  return line(
+      "fesd",
+      fmt::format("gamma_h = {:g}, step equilibration M = {:g}, h_penalty = {} (rho_h = "
+                  "{:g}), cross_comp_mode = {}",
+                  d.gamma_h, pds.M, pds.h_penalty ? 1 : 0, d.rho_h, to_string(d.cross_comp)));
+}
+
+std::string describe(const PdsSimulationProblem& problem) {
+  return describe_discretization(problem.options.discretization, problem.pds) +
+         "\nmodel as read\n" + describe_model(problem.model);
+}
+
+std::string describe(const PdsOcpProblem& problem) {
+  const std::string functions = describe_ocp_functions(problem.ocp);
+  return describe_discretization(problem.options.discretization, problem.ocp.pds) +
+         "\nmodel as read\n" + describe_model(problem.ocp.model) +
          (functions.empty() ? "" : "\ncosts and constraints as read\n" + functions);
 }
 

@@ -11,6 +11,7 @@
 
 #include "fesd/model.hpp"
 #include "fesd/options.hpp"
+#include "fesd/pds_problem_file.hpp"
 #include "fesd/problem_file.hpp"
 
 namespace fesd::io_detail {
@@ -28,11 +29,20 @@ std::string describe_discretization(const DiscretizationOptions& d);
 
 /// The OCP's costs and constraints as written (expressions with their bounds); empty if the OCP's
 /// functions are not expressions of a problem file.
-std::string describe_ocp_functions(const Ocp& ocp);
+std::string describe_ocp_functions(const OcpData& ocp);
+
+/// A projected system (docs/pds.md): its controls and parameters, every constraint c_k(x) >= 0
+/// and the vector field f, one line per state (C++ models: "(given in C++)").
+std::string describe_model(const Pds& model);
+/// The FESD settings of a projected system the header leaves out (gamma_h, rho_h, M,
+/// h_penalty), one line; empty without use_fesd.
+std::string describe_discretization(const DiscretizationOptions& d, const PdsOptions& pds);
 
 /// Everything `fesd check` prints after the header: describe_discretization, then a blank line and
 /// describe_model (and for an OCP describe_ocp_functions).
 std::string describe(const SimulationProblem& problem);
 std::string describe(const OcpProblem& problem);
+std::string describe(const PdsSimulationProblem& problem);
+std::string describe(const PdsOcpProblem& problem);
 
 }  // namespace fesd::io_detail

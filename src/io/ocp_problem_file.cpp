@@ -454,8 +454,8 @@ void apply_override(PdsOcpProblem& problem, std::string_view key, std::string_vi
   PdsOcpProblem updated = problem;
   if (set_ocp_override(arg, updated)) {
     // registry option or u_guess
-  } else if (!set_pds_override(arg, updated.ocp.model.n_x(), updated.ocp.model.n_u(),
-                               updated.options.nlp.extra, updated.ocp.x0, nullptr)) {
+  } else if (!set_pds_override(arg, updated.ocp.model, updated.options.nlp.extra, updated.ocp.x0,
+                               updated.ocp.p, nullptr)) {
     unknown_override(arg, kKind, Pss{});
   }
   ocp_detail::OcpInputErrors errors = ocp_detail::check_input(updated.ocp, updated.options);

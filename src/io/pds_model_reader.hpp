@@ -27,10 +27,10 @@ struct PdsModelRead {
 PdsModelRead read_pds_model(const Reader& r, const toml::table& root);
 
 /// The overrides of projected files that are not registry options: [ipopt] keys, model.x0 (n_x
-/// numbers), simulation.u (if `u` is given); tol_sim, t0 and p are rejected (InvalidOption).
-/// False for any other key.
-bool set_pds_override(const OverrideArg& a, int n_x, int n_u,
+/// numbers), model.p ("NAME=VALUE": p and model.p_default), simulation.u (if `u` is given);
+/// tol_sim and t0 are rejected (InvalidOption). False for any other key.
+bool set_pds_override(const OverrideArg& a, Pds& model,
                       std::vector<std::pair<std::string, std::string>>& ipopt_extra,
-                      Eigen::VectorXd& x0, Eigen::VectorXd* u);
+                      Eigen::VectorXd& x0, Eigen::VectorXd& p, Eigen::VectorXd* u);
 
 }  // namespace fesd::io_detail

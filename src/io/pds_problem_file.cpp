@@ -227,17 +227,20 @@ IntegratorResult simulate(const PdsSimulationProblem& q) {
 
 namespace io_detail {
 
-bool set_pds_override(const OverrideArg& a, int n_x, int n_u,
+bool set_pds_override(const OverrideArg& a, Pds& model,
                       std::vector<std::pair<std::string, std::string>>& ipopt_extra,
-                      Eigen::VectorXd& x0, Eigen::VectorXd* u) {
+                      Eigen::VectorXd& x0, Eigen::VectorXd& p, Eigen::VectorXd* u) {
   const std::string_view key = a.option != nullptr ? a.option->key : a.key;
+  const int n_x = model.n_x(), n_u = model.n_u();
   if (a.table == "ipopt" && !a.key.empty()) {
     set_ipopt_option(ipopt_extra, a.key, a.value);
   } else if ((a.table.empty() || a.table == "model") && a.key == "x0") {
     x0 = override_vector(a.head, a.value, n_x, "model.x0", "one per state");
   } else if (u != nullptr && key == "u") {
     *u = override_vector(a.head, a.value, n_u, "simulation.u", "one per control");
-  } else if (key == "tol_sim" || key == "t0" || (a.table.empty() && a.key == "p")) {
+  } else if (set_parameter_override(a, model.parameter_names, p, model.p_default)) {
+    // one parameter of model.p
+  } else if (key == "tol_sim" || key == "t0") {
     throw InvalidOption(fmt::format("{}: not supported for projected models yet", a.head));
   } else {
     return false;
@@ -256,8 +259,7 @@ void apply_override(PdsSimulationProblem& problem, std::string_view key, std::st
   s.N_sim = problem.N_sim;
   PdsSimulationProblem updated = problem;
   if (!set_scalar_override(arg, target_of(s)) &&
-      !set_pds_override(arg, updated.model.n_x(), updated.model.n_u(), s.options.nlp.extra,
-                        updated.x0, &updated.u))
+      !set_pds_override(arg, updated.model, s.options.nlp.extra, updated.x0, updated.p, &updated.u))
     unknown_override(arg, kKind, Pss{});
   if (s.tol_sim > 0)
     override_error(arg.head, "not supported for projected models yet (give N_sim)");

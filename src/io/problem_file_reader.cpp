@@ -704,8 +704,12 @@ bool set_model_override(const OverrideArg& a, Pss& model, bool has_clock, Eigen:
         override_vector(a.head, a.value, n_x_user, "model.x0", "one per state in model.x");
     return true;
   }
-  if (a.key != "p") return false;
-  const std::vector<std::string>& names = model.parameter_names;
+  return set_parameter_override(a, model.parameter_names, p, model.p_default);
+}
+
+bool set_parameter_override(const OverrideArg& a, const std::vector<std::string>& names,
+                            Eigen::VectorXd& p, Eigen::VectorXd& p_default) {
+  if ((!a.table.empty() && a.table != "model") || a.key != "p") return false;
   const std::size_t eq = a.value.find('=');
   const std::string name = trim(std::string_view(a.value).substr(0, eq));
   if (eq == std::string::npos || name.empty())
@@ -731,7 +735,7 @@ bool set_model_override(const OverrideArg& a, Pss& model, bool has_clock, Eigen:
     override_error(a.head, fmt::format("{} = {}: must be finite", path, format_number(*d)));
   const auto i = static_cast<Eigen::Index>(it - names.begin());
   p[i] = *d;
-  model.p_default[i] = *d;
+  p_default[i] = *d;
   return true;
 }
 

@@ -295,6 +295,10 @@ void set_ipopt_option(std::vector<std::pair<std::string, std::string>>& extra, s
 /// exactly n of them (`what`: "one per state"), all finite; throws InvalidOption "<head>: ...".
 Eigen::VectorXd override_vector(const std::string& head, std::string_view value, int n,
                                 std::string_view path, std::string_view what);
+/// "p" ("NAME=VALUE", one parameter of `names`, stored in p and p_default), with or without the
+/// "model." prefix; false for any other key. Shared by piecewise smooth and projected models.
+bool set_parameter_override(const OverrideArg& a, const std::vector<std::string>& names,
+                            Eigen::VectorXd& p, Eigen::VectorXd& p_default);
 /// The [model] overrides both kinds of problem have: "x0" (n_x numbers, the states of model.x;
 /// a clock keeps its start value) and "p" ("NAME=VALUE", one parameter of model.p, also stored
 /// as model.p_default), with or without the "model." prefix. False for any other key.

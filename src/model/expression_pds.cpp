@@ -56,6 +56,13 @@ class ExpressionPds final : public PdsFunctions {
   FESD_FOR_EACH_SCALAR(FESD_IMPLEMENT_EXPRESSION_PDS)
 #undef FESD_IMPLEMENT_EXPRESSION_PDS
 
+  const std::vector<expr::Expression>& f_expressions() const {
+    return f_;
+  }
+  const std::vector<expr::Expression>& c_expressions() const {
+    return c_;
+  }
+
  private:
   /// The symbol vector [x (n_x_slots), u, p]; an unused time slot holds 0, controls 0 if u is
   /// null (c reads none).
@@ -117,6 +124,12 @@ Pds make_expression_pds(PdsDims dims, ExpressionLayout layout, std::vector<expr:
                         "controls",
                         k, expr::shorten(c[k].text())));
   return Pds(dims, std::make_shared<ExpressionPds>(layout, std::move(f), std::move(c)));
+}
+
+PdsExpressionView expressions_of(const Pds& model) {
+  const auto* e = dynamic_cast<const ExpressionPds*>(&model.functions());
+  if (e == nullptr) return {};
+  return {&e->f_expressions(), &e->c_expressions()};
 }
 
 }  // namespace fesd

@@ -16,4 +16,12 @@ namespace fesd {
 Pds make_expression_pds(PdsDims dims, ExpressionLayout layout, std::vector<expr::Expression> f,
                         std::vector<expr::Expression> c);
 
+/// The parsed expressions of a Pss made by make_expression_pds (text() is the source), for
+/// descriptions of the model (`fesd check`); both null for a model given in C++.
+struct PdsExpressionView {
+  const std::vector<expr::Expression>* f = nullptr;
+  const std::vector<expr::Expression>* c = nullptr;
+};
+PdsExpressionView expressions_of(const Pds& model);
+
 }  // namespace fesd

@@ -12,7 +12,9 @@
 
 #include "core/util.hpp"
 #include "discretization/pds_interval.hpp"
+#include "fesd/error.hpp"
 #include "fesd/ocp.hpp"
+#include "fesd/pds.hpp"
 #include "mpcc/problem.hpp"
 #include "nlp/nlp_solver.hpp"
 #include "ocp/ocp_input.hpp"
@@ -72,6 +74,42 @@ void guess_constant(PdsOcpNlp& b, const PdsOcp& ocp, const ocp_detail::StagePara
   for (int i = 0; i < ocp.model.n_x(); ++i) w[b.s0[i]] = ocp.x0[i];
 }
 
+/// initialization = simulation: interval after interval, integrate() of the PDS from the state
+/// reached (x0 first) with the interval's control guess, its N_FE and the same scheme and
+/// homotopy; the guess is the simulated stage states, multipliers and element lengths. An interval
+/// whose simulation fails keeps the constant guess from there on (returned as a warning).
+std::string guess_simulation(PdsOcpNlp& b, const PdsOcp& ocp, const OcpOptions& o,
+                             const ocp_detail::StageParameters& p) {
+  auto& w = b.mpcc.guess();
+  Eigen::VectorXd x = ocp.x0;
+  const double T_k = ocp.T / ocp.N_stages;
+  for (std::size_t k = 0; k < b.iv.size(); ++k) {
+    const PdsInterval& iv = *b.iv[k];
+    const Eigen::VectorXd u = gather(w, b.q[k].empty() ? 0 : b.q[k][0], ocp.model.n_u());
+    IntegratorOptions io;
+    io.discretization = o.discretization;
+    io.discretization.N_FE = iv.N_FE();
+    io.homotopy = o.homotopy;
+    io.nlp = o.nlp;
+    IntegratorResult r;
+    try {
+      r = integrate(ocp.model, x, T_k, 1, io, u, p[k], ocp.pds);
+    } catch (const Error& e) {
+      r.status = Status::NlpFailed;
+      r.message = e.what();
+    }
+    if (r.status != Status::Success)
+      return fmt::format(
+          "initialization = simulation: the simulation of control interval {} failed ({}); the "
+          "constant guess x0 from there on",
+          k + 1, r.message);
+    iv.set_guess(w, x, r.x_stage, r.lambda, u, p[k]);
+    for (int n = 0; n < iv.N_FE(); ++n) w[iv.h(n)] = r.h[static_cast<std::size_t>(n)];
+    x = r.x_final();
+  }
+  return "";
+}
+
 void extract(const PdsOcpNlp& b, const PdsOcp& ocp, const std::vector<double>& w,
              const ocp_detail::StageParameters& /*fixed*/, OcpResult& res) {
   const int n_c = ocp.model.n_c();
@@ -97,11 +135,11 @@ OcpResult solve(const PdsOcp& ocp, const OcpOptions& options) {
   OcpResult res;
   res.mpcc_mode = options.homotopy.mpcc_mode;
   guess_constant(*b, ocp, p);
-  mp.finalize();
   res.summary.warnings = warnings(options.homotopy);
   if (options.initialization == OcpInitialization::Simulation)
-    res.summary.warnings.push_back(
-        "initialization = simulation is not supported for projected systems: x0 everywhere");
+    if (std::string w = guess_simulation(*b, ocp, options, p); !w.empty())
+      res.summary.warnings.push_back(std::move(w));
+  mp.finalize();
   res.summary.n_variables = mp.num_variables();
   res.summary.n_constraints = mp.num_constraints();
   res.summary.setup_s = seconds_since(t_start);

@@ -68,11 +68,31 @@ TEST_P(PdsExample1, FesdContactAndLeavingOnElementBoundaries) {
     if (r.t[n] > kContact + c.t_tol && r.t[n] < kLeave - c.t_tol) {
       EXPECT_NEAR(r.x[n][1], -1.0, 1e-9) << "t = " << r.t[n];
     }
+  // Every stage point of an element in contact lies on the boundary (for Lobatto IIIC also its
+  // first stage, whose c has no sign condition: c(X_{n,1}) = 0 where a lambda is positive).
+  const int n_s = c.n_s;
+  for (std::size_t n = 0; n < r.active_set.size(); ++n) {
+    if (r.active_set[n].empty()) continue;
+    for (int i = 0; i < n_s; ++i) {
+      EXPECT_NEAR(r.x_stage[n * n_s + i][1], -1.0, 1e-9) << "element " << n << ", stage " << i;
+    }
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(RadauIIA, PdsExample1,
                          ::testing::Values(Case{2, 20, 1.2e-3, 1e-3}, Case{2, 40, 2e-4, 1.5e-4},
                                            Case{3, 10, 3e-5, 1.5e-5}, Case{3, 20, 6e-7, 8e-7}));
+
+// FESD with Lobatto IIIC (order 2 n_s - 2; stage 1 without sign condition on c, docs/pds.md
+// "Lobatto IIIC"). Measured (n_s, N_FE): x(T) error, contact / leaving time error
+//   (2, 40) 6.8e-3, 2.9e-3 / 3.5e-3     (3, 10) 3.7e-4, 8.6e-5 / 1.3e-4
+//   (3, 20) 1.5e-5, 5.8e-6 / 7.1e-6     (4, 10) 5.7e-7, 1.1e-7 / 1.4e-7
+constexpr auto kLobatto = fesd::RkScheme::LobattoIIIC;
+INSTANTIATE_TEST_SUITE_P(LobattoIIIC, PdsExample1,
+                         ::testing::Values(Case{2, 40, 2e-2, 1e-2, kLobatto},
+                                           Case{3, 10, 1.2e-3, 4e-4, kLobatto},
+                                           Case{3, 20, 5e-5, 2.5e-5, kLobatto},
+                                           Case{4, 10, 2e-6, 5e-7, kLobatto}));
 
 // The standard method (6) with the same grid: the switch inside an element costs it its order.
 // Measured: n_s = 2, N_FE = 20: 5.0e-3 (FESD 3.9e-4); N_FE = 40: 1.7e-3 (FESD 6.0e-5).

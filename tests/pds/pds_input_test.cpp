@@ -71,14 +71,6 @@ TEST(PdsInput, SchemesWithoutLastNodeOneRejected) {
   }
 }
 
-TEST(PdsInput, FesdWithLobattoIIICRejected) {
-  fesd::IntegratorOptions o;
-  o.discretization.rk_scheme = fesd::RkScheme::LobattoIIIC;
-  const std::string m = message_of<fesd::InvalidOption>(
-      [&] { fesd::integrate(half_plane(), Eigen::Vector2d(1.0, 1.0), 1.0, 1, o); });
-  EXPECT_NE(m.find("lobatto_iiic with use_fesd"), std::string::npos) << m;
-}
-
 TEST(PdsInput, NonPositiveMRejected) {
   fesd::PdsOptions pds;
   pds.M = 0;

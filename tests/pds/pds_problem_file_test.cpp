@@ -225,6 +225,56 @@ TEST(PdsCli, Overrides) {
   }
 }
 
+// `fesd check` of projected files: the header and the model as read (constraints, f, the
+// parameters after --p), exit 0; a bad file: exit 2 with one line.
+TEST(PdsCli, CheckDescribesTheModel) {
+  TempDir dir;
+  const std::string file = dir.file("ex1.toml");
+  {
+    std::ofstream f(file);
+    f << kExample1;
+  }
+  const CliRun r = fesd_cli("'" + file + "' --p a=2 --n_s 2", "check");
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const char* part : {"projected dynamical system, n_x = 2, n_c = 1", "n_s = 2",
+                           "parameters  a = 2", "c[0]        x2 + a >= 0",
+                           "f           x1' = x2,  x2' = -x1", "is valid (nothing was solved)"})
+    EXPECT_NE(r.out.find(part), std::string::npos) << part << "\n" << r.out;
+  const CliRun ocp =
+      fesd_cli(std::string(FESD_SOURCE_DIR) + "/examples/ocp_pds_discs.toml", "check");
+  ASSERT_EQ(ocp.code, 0) << ocp.err;
+  for (const char* part : {"optimal control of a projected dynamical system", "controls    u1, v1",
+                           "c[1]        (x3 - x2)^2", "costs and constraints as read", "f_q_T"})
+    EXPECT_NE(ocp.out.find(part), std::string::npos) << part << "\n" << ocp.out;
+  for (const std::string& bad : {std::string("--p b=2"), std::string("--tol_sim 1e-3")}) {
+    const CliRun e = fesd_cli("'" + file + "' " + bad, "check");
+    EXPECT_EQ(e.code, 2) << bad;
+    EXPECT_EQ(std::count(e.err.begin(), e.err.end(), '\n'), 1) << bad << ": " << e.err;
+  }
+  {
+    std::ofstream f(file);
+    f << replace(kExample1, "f = [", "fx = [");
+  }
+  const CliRun e = fesd_cli("'" + file + "'", "check");
+  EXPECT_EQ(e.code, 2);
+  EXPECT_NE(e.err.find("unknown key 'fx'"), std::string::npos) << e.err;
+}
+
+// --p NAME=VALUE of a projected file: the parameter and the model's default (what plots and
+// results use) change together.
+TEST(PdsProblemFile, ParameterOverride) {
+  fesd::PdsSimulationProblem p = fesd::parse_pds_simulation_problem(kExample1, "f.toml");
+  fesd::apply_override(p, "p", "a=0.5");
+  EXPECT_EQ(p.p[0], 0.5);
+  EXPECT_EQ(p.model.p_default[0], 0.5);
+  EXPECT_THROW(fesd::apply_override(p, "p", "b=1"), fesd::InvalidOption);
+  // The contact is now at x2 = -0.5: with the wall closer the trajectory slides on it.
+  const fesd::IntegratorResult r = fesd::simulate(p);
+  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+  ASSERT_FALSE(r.switches.empty());
+  EXPECT_NEAR(r.x[r.switches[0].element + 1][1], -0.5, 1e-9);
+}
+
 }  // namespace
 
 namespace {
@@ -293,6 +343,24 @@ TEST(PdsOcpProblemFile, Wall) {
   EXPECT_NEAR(r.x_final()[0], 0.0, 1e-6);
 }
 
+// initialization = simulation (docs/pds.md): the guess is a simulation of every control interval
+// with u_guess = -1, which reaches the wall in the second interval (contact in the guess); the
+// solution is the one of the constant guess.
+TEST(PdsOcpProblemFile, WallFromSimulation) {
+  fesd::PdsOcpProblem q = fesd::parse_pds_ocp_problem(kWall, "f.toml");
+  const fesd::OcpResult constant = fesd::solve(q.ocp, q.options);
+  fesd::apply_override(q, "initialization", "simulation");
+  fesd::apply_override(q, "u_guess", "-1");
+  const fesd::OcpResult r = fesd::solve(q.ocp, q.options);
+  ASSERT_EQ(constant.status, fesd::Status::Success) << constant.message;
+  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+  for (const std::string& w : r.summary.warnings)
+    EXPECT_EQ(w.find("initialization"), std::string::npos) << w;
+  EXPECT_LE(r.comp_residual, 1e-9);
+  EXPECT_NEAR(r.objective, constant.objective, 1e-6);
+  EXPECT_NEAR(r.x_final()[0], 0.0, 1e-6);
+}
+
 // examples/ocp_pds_discs.toml is the problem of bench/pds_discs_model.hpp (solved in
 // tests/pds/pds_ocp_test.cpp).
 TEST(PdsOcpProblemFile, DiscsExampleReads) {
@@ -326,8 +394,9 @@ TEST(PdsOcpProblemFile, BadInputOneLineEach) {
   has(ocp_error_of<fesd::ProblemFileError>(replace(kWall, "x0 = [1.0]", "x0 = [inf]")),
       "must be finite");
   has(ocp_error_of<fesd::Error>(replace(kWall, "x0 = [1.0]", "x0 = [-0.5]")), "x0 lies outside C");
-  has(ocp_error_of<fesd::Error>(replace(kWall, "n_s = 2", "n_s = 2\nrk_scheme = \"lobatto_iiic\"")),
-      "lobatto_iiic");
+  has(ocp_error_of<fesd::Error>(
+          replace(kWall, "n_s = 2", "n_s = 2\nrk_scheme = \"gauss_legendre\"")),
+      "gauss_legendre");
   has(ocp_error_of<fesd::ProblemFileError>(
           replace(kWall, "[ocp]", "[simulation]\nT_sim = 1\n[ocp]")),
       "simulation");
