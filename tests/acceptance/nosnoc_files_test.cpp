@@ -143,13 +143,15 @@ namespace {
 // settings (|u| <= 30, heuristic_delta, comp_tol 1e-8, bounds at the stage points) it is the same
 // problem, so it must reach the same objective, 678.50 (nosnoc_py's value, tested for that file
 // in nosnoc_examples_test.cpp). As written (|u| <= 10, heuristic_mean) it swings up more slowly:
-// J = 1870.47 measured, the pole upright at T to 2e-3.
+// J = 1870.47 measured with the KKT module's cold scaling of every factorization and 1869.99
+// with its warm-started scaling (two nearby local minima of this nonconvex problem, reached
+// through round-off), the pole upright at T to 2e-3.
 TEST(NosnocFiles, ParametricCartPoleEqualsTheInlinedModel) {
   fesd::OcpProblem p =
       fesd::load_ocp_problem(example_path("parametric_cart_pole_with_friction.toml"));
   fesd::OcpResult r = fesd::solve(p.ocp, p.options);
   ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
-  EXPECT_NEAR(r.objective, 1870.47, 0.05);
+  EXPECT_NEAR(r.objective, 1870.2, 0.5);
   EXPECT_NEAR(r.x_final()[1], M_PI, 3e-3);
 
   p.ocp.lbu[0] = -30.0;
