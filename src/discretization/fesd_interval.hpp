@@ -20,6 +20,7 @@
 
 #include <Eigen/Dense>
 
+#include "core/util.hpp"
 #include "dcs/stewart.hpp"
 #include "fesd/model.hpp"
 #include "fesd/options.hpp"
@@ -286,5 +287,28 @@ class FesdInterval {
   std::vector<int> step_eq_rows_;
   std::vector<std::vector<int>> lam_sum_, th_sum_;  // lifted sums of (31), per element, region
 };
+
+/// Appends the multipliers of stage (n, m) of the solution w to a result (IntegratorResult or
+/// OcpResult): lambda per region (in the step form the per-region multiplier made from lambda_n,
+/// lambda_p) and, in the step form, alpha, lambda_n and lambda_p; in Stewart's form also mu where
+/// the result has it.
+template <class Result>
+void append_stage_multipliers(const FesdInterval& iv, const Pss& model,
+                              const std::vector<double>& w, int n, int m, Result& res) {
+  const int n_th = model.n_theta();
+  if (iv.step_mode()) {
+    Eigen::VectorXd lam(n_th);
+    for (int r = 0; r < n_th; ++r) lam[r] = iv.region_lambda(w.data(), n, m, r);
+    res.lambda.push_back(lam);
+    const int n_c = model.n_c();
+    res.alpha.push_back(util::gather(w, iv.alpha(n, m, 0), n_c));
+    res.lambda_n.push_back(util::gather(w, iv.lambda(n, m, 0), n_c));
+    res.lambda_p.push_back(util::gather(w, iv.lambda(n, m, n_c), n_c));
+    return;
+  }
+  res.lambda.push_back(util::gather(w, iv.lambda(n, m, 0), n_th));
+  if constexpr (requires { res.mu; })
+    res.mu.push_back(util::gather(w, iv.mu(n, m, 0), model.n_sys()));
+}
 
 }  // namespace fesd::discretization

@@ -38,7 +38,7 @@ using Clock = std::chrono::steady_clock;
 /// Appends the N_FE elements of a step (NLP point w) to the result; advances t.
 void append_step(IntegratorResult& res, const Pss& model, const discretization::FesdInterval& iv,
                  const Tableau& tab, const std::vector<double>& w, double& t) {
-  const int n_x = model.n_x(), n_th = model.n_theta(), n_sys = model.n_sys();
+  const int n_x = model.n_x(), n_th = model.n_theta();
   for (int n = 0; n < iv.N_FE(); ++n) {
     const double hn = w[iv.h(n)];
     const std::vector<int> active = iv.active_set(w.data(), n);
@@ -46,18 +46,7 @@ void append_step(IntegratorResult& res, const Pss& model, const discretization::
       res.t_stage.push_back(t + tab.c(s) * hn);
       res.x_stage.push_back(gather(w, iv.X(n, s, 0), n_x));
       res.theta.push_back(gather(w, iv.theta(n, s, 0), n_th));
-      if (iv.step_mode()) {
-        Eigen::VectorXd lam(n_th);
-        for (int r = 0; r < n_th; ++r) lam[r] = iv.region_lambda(w.data(), n, s, r);
-        res.lambda.push_back(lam);
-        const int n_c = model.n_c();
-        res.alpha.push_back(gather(w, iv.alpha(n, s, 0), n_c));
-        res.lambda_n.push_back(gather(w, iv.lambda(n, s, 0), n_c));
-        res.lambda_p.push_back(gather(w, iv.lambda(n, s, n_c), n_c));
-      } else {
-        res.lambda.push_back(gather(w, iv.lambda(n, s, 0), n_th));
-        res.mu.push_back(gather(w, iv.mu(n, s, 0), n_sys));
-      }
+      discretization::append_stage_multipliers(iv, model, w, n, s, res);
     }
     if (!res.active_set.empty() && res.active_set.back() != active)
       res.switches.push_back(

@@ -271,17 +271,7 @@ void extract(const OcpNlp& b, const Ocp& ocp, const std::vector<double>& w,
       ocp, b.tab, m.n_x(), m.n_u(), b.s0, b.q, b.iv, b.terminal_slacks, w, p, res,
       [&](const FesdInterval& iv, int n, int s) {
         res.theta.push_back(gather(w, iv.theta(n, s, 0), n_th));
-        if (iv.step_mode()) {
-          Eigen::VectorXd lam(n_th);
-          for (int r = 0; r < n_th; ++r) lam[r] = iv.region_lambda(w.data(), n, s, r);
-          res.lambda.push_back(lam);
-          const int n_c = m.n_c();
-          res.alpha.push_back(gather(w, iv.alpha(n, s, 0), n_c));
-          res.lambda_n.push_back(gather(w, iv.lambda(n, s, 0), n_c));
-          res.lambda_p.push_back(gather(w, iv.lambda(n, s, n_c), n_c));
-        } else {
-          res.lambda.push_back(gather(w, iv.lambda(n, s, 0), n_th));
-        }
+        discretization::append_stage_multipliers(iv, m, w, n, s, res);
       },
       [&](const FesdInterval& iv) { return iv.eta(w.data()); });
 }
