@@ -2,8 +2,8 @@
 // paper's and nosnoc_py's OCPs? (issue 14, item 2)
 //
 // For the sliding-mode OCP (61) (examples/ocp_sliding_mode.toml), nosnoc_py's cart pole with
-// friction (examples/cart_pole_with_friction.toml) and its motor with friction
-// (examples/motor_with_friction.toml): each file solved as written except mpcc_mode and
+// friction (examples/nosnoc/cart_pole_with_friction.toml) and its motor with friction
+// (examples/nosnoc/motor_with_friction.toml): each file solved as written except mpcc_mode and
 // step_equilibration, one row per pair, against a reference: the same file on a grid with
 // --fine times as many finite elements per control interval (default 4), its best objective over
 // the step-equilibration modes of --ref-modes (default: every mode, scholtes_ineq). Columns:
@@ -96,8 +96,8 @@ void print(const Row& r) {
 
 int main(int argc, char** argv) {
   const std::vector<Problem> all = {{"sliding", "examples/ocp_sliding_mode.toml"},
-                                    {"cartpole", "examples/cart_pole_with_friction.toml"},
-                                    {"motor", "examples/motor_with_friction.toml"}};
+                                    {"cartpole", "examples/nosnoc/cart_pole_with_friction.toml"},
+                                    {"motor", "examples/nosnoc/motor_with_friction.toml"}};
   std::vector<std::string> only, methods = {"scholtes_ineq", "scholtes_eq", "fischer_burmeister",
                                             "ell_1_penalty", "elastic_ineq"};
   std::vector<std::string> modes = {"l2_relaxed", "heuristic_mean", "heuristic_delta", "eta",

@@ -1,5 +1,5 @@
 // nosnoc_py's examples written as fesd problem files. The relay feedback, friction block and
-// periodic stick-slip simulations (examples/relay_feedback.toml, friction_block.toml,
+// periodic stick-slip simulations (examples/nosnoc/relay_feedback.toml, friction_block.toml,
 // periodic_stick_slip.toml):
 // their switch lists at complementarity_tol 1e-6 and 1e-12 (issue 13, item 10: the activity rule
 // theta against lambda and the re-solve with the active set fixed). With the old rule (theta >
@@ -8,8 +8,8 @@
 // horizon whose switches are known from an event-driven reference solution (matrix exponentials
 // for the relay, RK4 with step 1e-3 and bisection for the others, accurate to 1e-9 or better).
 // Then the motor with friction and cart pole OCPs and the temperature control simulation
-// (examples/motor_with_friction.toml, cart_pole_with_friction.toml, temperature_control.toml)
-// against nosnoc_py's results in NOSNOC-EXAMPLES.md (issue 14).
+// (examples/nosnoc/motor_with_friction.toml, cart_pole_with_friction.toml,
+// temperature_control.toml) against nosnoc_py's results in NOSNOC-EXAMPLES.md (issue 14).
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -67,7 +67,7 @@ const std::vector<Tolerance> kTolerances = {{"1e-6", "1e-8"}, {"1e-12", "1e-13"}
 class RelayFeedback : public ::testing::TestWithParam<Tolerance> {};
 
 TEST_P(RelayFeedback, ExitEntryExitAtEveryTolerance) {
-  SimulationProblem p = load_example("relay_feedback.toml", GetParam());
+  SimulationProblem p = load_example("nosnoc/relay_feedback.toml", GetParam());
   fesd::apply_override(p, "x0", "0, -0.9190046231960544, 0.5905093536281034");
   fesd::apply_override(p, "T_sim", "0.35");
   fesd::apply_override(p, "N_sim", "7");
@@ -115,7 +115,7 @@ TEST_P(FrictionBlock, TwoCrossingsInTheFirstQuarterSecond) {
   const double exact_t[] = {0.207736371, 0.248685443};
   for (const Path& path : paths) {
     SCOPED_TRACE(path.step_solver);
-    SimulationProblem p = load_example("friction_block.toml", GetParam());
+    SimulationProblem p = load_example("nosnoc/friction_block.toml", GetParam());
     fesd::apply_override(p, "T_sim", "0.25");
     fesd::apply_override(p, "N_sim", "6");  // the file's step, 5 / 120
     fesd::apply_override(p, "step_solver", path.step_solver);
@@ -147,7 +147,7 @@ INSTANTIATE_TEST_SUITE_P(CompTol, FrictionBlock, ::testing::ValuesIn(kTolerances
 class PeriodicStickSlip : public ::testing::TestWithParam<Tolerance> {};
 
 TEST_P(PeriodicStickSlip, SticksOnOneSurfaceThenOnBoth) {
-  SimulationProblem p = load_example("periodic_stick_slip.toml", GetParam());
+  SimulationProblem p = load_example("nosnoc/periodic_stick_slip.toml", GetParam());
   fesd::apply_override(p, "step_solver", "homotopy");  // the file uses active_set
   fesd::apply_override(p, "T_sim", "0.6");
   fesd::apply_override(p, "N_sim", "3");
@@ -175,7 +175,7 @@ INSTANTIATE_TEST_SUITE_P(CompTol, PeriodicStickSlip, ::testing::ValuesIn(kTolera
 // alone). Two steps of the file's grid. At complementarity_tol 1e-9 the exit is pinned and
 // located (measured 4.8e-7 early); at 1e-12 it comes 5.5e-4 early with located = false.
 SimulationProblem stick_slip_from_the_intersection(const Tolerance& tol) {
-  SimulationProblem p = load_example("periodic_stick_slip.toml", tol);
+  SimulationProblem p = load_example("nosnoc/periodic_stick_slip.toml", tol);
   fesd::apply_override(p, "step_solver", "homotopy");  // the file uses active_set
   fesd::apply_override(p, "x0", "0.9409579470134545, 0.2, 0.4");
   fesd::apply_override(p, "T_sim", "0.4");
@@ -216,8 +216,8 @@ TEST(PeriodicStickSlipExit, AnExitAtAStepBoundaryIsLocatedOrMarked) {
 // default l2_relaxed ends in another one (702.27).
 // Measured: about 6 s of CPU in a Release build.
 TEST(NosnocCartPole, ReachesNosnocPysObjective) {
-  const fesd::OcpProblem p = fesd::load_ocp_problem(std::string(FESD_SOURCE_DIR) +
-                                                    "/examples/cart_pole_with_friction.toml");
+  const fesd::OcpProblem p = fesd::load_ocp_problem(
+      std::string(FESD_SOURCE_DIR) + "/examples/nosnoc/cart_pole_with_friction.toml");
   ASSERT_EQ(p.options.discretization.step_eq, fesd::StepEq::HeuristicDelta);
   ASSERT_TRUE(p.options.constraints_at_stages);
   const fesd::OcpResult r = fesd::solve(p.ocp, p.options);
@@ -239,8 +239,8 @@ TEST(NosnocCartPole, ReachesNosnocPysObjective) {
 // 2-switch solution. x(T) is the target exactly (a hard terminal constraint). Measured: about
 // 10 s of CPU in a Release build, the slowest of these tests.
 TEST(NosnocMotorWithFriction, ObjectiveAndTarget) {
-  const fesd::OcpProblem p =
-      fesd::load_ocp_problem(std::string(FESD_SOURCE_DIR) + "/examples/motor_with_friction.toml");
+  const fesd::OcpProblem p = fesd::load_ocp_problem(std::string(FESD_SOURCE_DIR) +
+                                                    "/examples/nosnoc/motor_with_friction.toml");
   ASSERT_EQ(p.options.discretization.step_eq, fesd::StepEq::L2Relaxed);
   const fesd::OcpResult r = fesd::solve(p.ocp, p.options);
   ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
@@ -279,7 +279,7 @@ double exact_temperature(double t) {
 // (no companion runs); measured about 5 s of CPU in a Release build.
 TEST(NosnocTemperatureControl, FollowsTheHysteresisInPhysicalTime) {
   SimulationProblem p = fesd::load_simulation_problem(std::string(FESD_SOURCE_DIR) +
-                                                      "/examples/temperature_control.toml");
+                                                      "/examples/nosnoc/temperature_control.toml");
   const IntegratorResult r = run_example(p);
   ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
   double worst = 0;

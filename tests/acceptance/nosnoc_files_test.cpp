@@ -138,8 +138,8 @@ TEST(NosnocFiles, SimpleCarAboveTheContinuousOptimumByLessThanOnePercent) {
 
 namespace {
 
-// The parametric cart pole writes the model of examples/cart_pole_with_friction.toml with the
-// masses and references as global and per-interval parameters. With that file's bounds and
+// The parametric cart pole writes the model of examples/nosnoc/cart_pole_with_friction.toml with
+// the masses and references as global and per-interval parameters. With that file's bounds and
 // settings (|u| <= 30, heuristic_delta, comp_tol 1e-8, bounds at the stage points) it is the same
 // problem, so it must reach the same objective, 678.50 (nosnoc_py's value, tested for that file
 // in nosnoc_examples_test.cpp). As written (|u| <= 10, heuristic_mean) it swings up more slowly:

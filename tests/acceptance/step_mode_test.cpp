@@ -47,7 +47,7 @@ struct Case {
 std::string case_name(const ::testing::TestParamInfo<Case>& info) {
   std::string s = info.param.file;
   s = s.substr(0, s.find('.'));
-  return s;
+  return s.substr(s.find('/') + 1);  // the file's name without a folder (nosnoc/)
 }
 
 class StepVsStewart : public ::testing::TestWithParam<Case> {};
@@ -97,11 +97,11 @@ TEST_P(StepVsStewart, SameTrajectoryAndSwitches) {
 
 INSTANTIATE_TEST_SUITE_P(
     Examples, StepVsStewart,
-    ::testing::Values(Case{"crossing.toml", {}, 1e-8, 1e-8}, Case{"sliding.toml", {}, 1e-8, 1e-8},
-                      Case{"leaving_sliding.toml", {}, 1e-7, 1e-6},
-                      Case{"oscillator.toml", {}, 1e-7, 1e-7},
-                      Case{"relay_feedback.toml", {{"T_sim", "3.0"}, {"N_sim", "60"}}, 1e-6, 1e-6},
-                      Case{"friction_block.toml", {{"T_sim", "1.5"}, {"N_sim", "36"}}, 1e-6, 1e-6}),
+    ::testing::Values(
+        Case{"crossing.toml", {}, 1e-8, 1e-8}, Case{"sliding.toml", {}, 1e-8, 1e-8},
+        Case{"leaving_sliding.toml", {}, 1e-7, 1e-6}, Case{"oscillator.toml", {}, 1e-7, 1e-7},
+        Case{"nosnoc/relay_feedback.toml", {{"T_sim", "3.0"}, {"N_sim", "60"}}, 1e-6, 1e-6},
+        Case{"nosnoc/friction_block.toml", {{"T_sim", "1.5"}, {"N_sim", "36"}}, 1e-6, 1e-6}),
     case_name);
 
 // ---- codimension 2: the periodic stick-slip (two switching functions, four regions) ------------
@@ -114,7 +114,7 @@ INSTANTIATE_TEST_SUITE_P(
 // (20 listed switches to t = 2.6), while theta_0(alpha) = (1 - alpha_1)(1 - alpha_2) is exactly 0
 // once alpha_2 = 1 (x3 > 0.4): the step form lists the two switches only.
 TEST(StepMode, PeriodicStickSlipCodimTwoSameStates) {
-  SimulationProblem p = fesd::load_simulation_problem(example("periodic_stick_slip.toml"));
+  SimulationProblem p = fesd::load_simulation_problem(example("nosnoc/periodic_stick_slip.toml"));
   fesd::apply_override(p, "T_sim", "2.5");
   fesd::apply_override(p, "N_sim", "25");
   const IntegratorResult a = run(p, "stewart");
@@ -194,7 +194,7 @@ TEST(StepMode, SensitivityOcpSameObjective) {
 // each, so both forms have the same Filippov sets; the same solution (measured: J equal to 1e-10,
 // states at the element boundaries to 1.6e-10, switch times to 3.4e-11).
 TEST(StepMode, SlidingModeOcpSameObjective) {
-  fesd::OcpProblem q = fesd::load_ocp_problem(example("ocp_sliding_mode_nosnoc.toml"));
+  fesd::OcpProblem q = fesd::load_ocp_problem(example("nosnoc/ocp_sliding_mode_nosnoc.toml"));
   fesd::OcpProblem s = q;
   fesd::apply_override(s, "dcs_mode", "step");
   const fesd::OcpResult a = fesd::solve(q.ocp, q.options);
@@ -235,10 +235,10 @@ TEST(StepMode, JsonHasStepValues) {
 
 // ---- bad input ---------------------------------------------------------------------------------
 
-// A g-form subsystem (examples/temperature_control.toml gives g directly) cannot be written in
-// the step form: the library throws InvalidModel naming the key.
+// A g-form subsystem (examples/nosnoc/temperature_control.toml gives g directly) cannot be written
+// in the step form: the library throws InvalidModel naming the key.
 TEST(StepMode, GFormRejected) {
-  SimulationProblem p = fesd::load_simulation_problem(example("temperature_control.toml"));
+  SimulationProblem p = fesd::load_simulation_problem(example("nosnoc/temperature_control.toml"));
   try {  // the problem file's override is checked at once
     fesd::apply_override(p, "dcs_mode", "step");
     FAIL() << "no exception";
@@ -266,7 +266,8 @@ TEST(StepMode, UnknownValueRejected) {
 // The CLI: one line naming the problem, exit code 2.
 TEST(StepMode, CliGFormExitCode2) {
   const std::string cmd = std::string(FESD_CLI) + " simulate " +
-                          example("temperature_control.toml") + " --dcs_mode step > /dev/null 2>&1";
+                          example("nosnoc/temperature_control.toml") +
+                          " --dcs_mode step > /dev/null 2>&1";
   const int rc = std::system(cmd.c_str());
   ASSERT_TRUE(WIFEXITED(rc));
   EXPECT_EQ(WEXITSTATUS(rc), 2);

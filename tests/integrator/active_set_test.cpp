@@ -242,16 +242,16 @@ TEST(ActiveSetSliding, CodimensionTwoInACartesianProduct) {
   EXPECT_EQ(b.active.summary.homotopy_path_steps, 0);
 }
 
-// examples/temperature_control.toml (nosnoc_py's hysteresis example, 4 regions in one subsystem,
-// time freezing): the sliding entries {2} -> {2, 3} at t = 0.5 and 2.6 are taken by Newton. At
-// the triple point psi = 1, w = 0 region 1's field is 0 (a Filippov equilibrium): the sliding
-// candidate {0, 1, 2} there has theta = (0, 1, 0), on the simplex boundary, and is refused
+// examples/nosnoc/temperature_control.toml (nosnoc_py's hysteresis example, 4 regions in one
+// subsystem, time freezing): the sliding entries {2} -> {2, 3} at t = 0.5 and 2.6 are taken by
+// Newton. At the triple point psi = 1, w = 0 region 1's field is 0 (a Filippov equilibrium): the
+// sliding candidate {0, 1, 2} there has theta = (0, 1, 0), on the simplex boundary, and is refused
 // (sliding_is_filippov); those steps fall back to the homotopy, whose relaxed homotopy (sigma_N
 // = 1e-2) carries the state over the equilibrium. The file's complementarity_tol is 1e-2: the
 // homotopy path's exact re-solves leave its switch at 2.6 3.9e-7 early (its element starts
 // sliding at w = 1 - 9.8e-7), so the paths agree to 1e-6 in the switch times, 1e-7 in x(T).
 TEST(ActiveSetSliding, TemperatureControlSameAsHomotopy) {
-  const Both b = run_file("temperature_control.toml");
+  const Both b = run_file("nosnoc/temperature_control.toml");
   expect_same(b, 1e-6);
   EXPECT_LT((b.active.x_final() - b.homotopy.x_final()).lpNorm<Eigen::Infinity>(), 1e-7);
   ASSERT_EQ(b.active.switches.size(), 7u);
@@ -267,8 +267,8 @@ TEST(ActiveSetSliding, TemperatureControlSameAsHomotopy) {
       30);
 }
 
-// examples/periodic_stick_slip.toml (nosnoc_py's codim-2 example: one subsystem, four regions of
-// c = (x2 - 0.2, x3 - 0.4), Radau IIA n_s = 4, N_FE = 3, N_sim = 100 on [0, 20]). On the
+// examples/nosnoc/periodic_stick_slip.toml (nosnoc_py's codim-2 example: one subsystem, four
+// regions of c = (x2 - 0.2, x3 - 0.4), Radau IIA n_s = 4, N_FE = 3, N_sim = 100 on [0, 20]). On the
 // intersection of both surfaces f_0 = f_1, so the four-region set has a one-parameter family of
 // theta: its system is not square. Every step runs on the active-set path with the regular
 // selection {0, 3} (theta_1 = theta_2 = 0: ActiveSetStep::selections, the two-region sets of an
@@ -280,7 +280,7 @@ TEST(ActiveSetSliding, TemperatureControlSameAsHomotopy) {
 // 1 at entries and exits), and its x(20) is 3.2e-4 off.
 TEST(ActiveSetSliding, StickSlipCodimensionTwoEvents) {
   fesd::SimulationProblem q =
-      fesd::load_simulation_problem(FESD_SOURCE_DIR "/examples/periodic_stick_slip.toml");
+      fesd::load_simulation_problem(FESD_SOURCE_DIR "/examples/nosnoc/periodic_stick_slip.toml");
   fesd::apply_override(q, "step_solver", "active_set");
   const IntegratorResult r = fesd::integrate(q.model, q.x0, q.T_sim, q.N_sim, q.options, q.u, q.p);
   ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
@@ -321,17 +321,17 @@ TEST(ActiveSetTwoSwitches, CartesianProductEntriesInOneStep) {
   EXPECT_EQ(b.active.h.size(), 14u);
 }
 
-// examples/relay_feedback.toml at complementarity_tol 1e-9, sigma_N 1e-13 (where the homotopy
-// path is tight; it takes ~30 s, so its result is quoted here, not recomputed): the short slides
-// whose entry and exit lie in one step of 50 ms (steps from 5.65, 5.9, 8.65, 8.9, 9.1, 9.15) are
-// solved as half steps, every step by Newton. The homotopy path lists 22 switches; the active-set
-// path lists them too, within 3.5e-3 (this grid's accuracy: against the event list of a run with
-// N_sim = 4000, n_s = 3 the homotopy's are within 3.2e-3, the active-set path's within 5e-3), and
-// 4 more: the slides at 5.674-5.689 and 8.655-8.670 of the exact solution (34 switches), which
-// the homotopy's 4-element retry steps over (the state passes at x1 ~ 1e-4).
+// examples/nosnoc/relay_feedback.toml at complementarity_tol 1e-9, sigma_N 1e-13 (where the
+// homotopy path is tight; it takes ~30 s, so its result is quoted here, not recomputed): the short
+// slides whose entry and exit lie in one step of 50 ms (steps from 5.65, 5.9, 8.65, 8.9, 9.1, 9.15)
+// are solved as half steps, every step by Newton. The homotopy path lists 22 switches; the
+// active-set path lists them too, within 3.5e-3 (this grid's accuracy: against the event list of a
+// run with N_sim = 4000, n_s = 3 the homotopy's are within 3.2e-3, the active-set path's within
+// 5e-3), and 4 more: the slides at 5.674-5.689 and 8.655-8.670 of the exact solution (34 switches),
+// which the homotopy's 4-element retry steps over (the state passes at x1 ~ 1e-4).
 TEST(ActiveSetTwoSwitches, RelayFeedbackShortSlidesByNewton) {
   fesd::SimulationProblem q =
-      fesd::load_simulation_problem(FESD_SOURCE_DIR "/examples/relay_feedback.toml");
+      fesd::load_simulation_problem(FESD_SOURCE_DIR "/examples/nosnoc/relay_feedback.toml");
   fesd::apply_override(q, "complementarity_tol", "1e-9");
   fesd::apply_override(q, "sigma_N", "1e-13");
   fesd::apply_override(q, "step_solver", "active_set");

@@ -170,7 +170,7 @@ TEST(OcpExamples, SlidingModeIsTheCppProblem) {
 }
 
 TEST(OcpExamples, SlidingModeNosnocIsTheCppProblem) {
-  expect_same_problem(load_example("ocp_sliding_mode_nosnoc.toml"),
+  expect_same_problem(load_example("nosnoc/ocp_sliding_mode_nosnoc.toml"),
                       fesd_bench::sliding_ocp_nosnoc(), fesd_bench::sliding_options());
 }
 

@@ -181,7 +181,7 @@ struct OcpTerms {
 };
 
 TEST(HessianPasses, ProblemFileOcpFunctionsMatchTheColumnPasses) {
-  for (const char* file : {"ocp_sliding_mode_nosnoc.toml", "ocp_sliding_mode.toml"}) {
+  for (const char* file : {"nosnoc/ocp_sliding_mode_nosnoc.toml", "ocp_sliding_mode.toml"}) {
     SCOPED_TRACE(file);
     const fesd::OcpProblem problem = fesd::load_ocp_problem(example(file));
     const fesd::Ocp& ocp = problem.ocp;
@@ -248,7 +248,7 @@ void expect_same_dynamics(const fesd::Pss& model, unsigned seed) {
 TEST(HessianPasses, DynamicsBlockMatchesAutoDiff) {
   const fesd::Pss cpp_model = fesd_test::nonlinear_model();
   expect_same_dynamics(cpp_model, 21U);
-  for (const char* file : {"ocp_sliding_mode_nosnoc.toml", "ocp_sliding_mode.toml"}) {
+  for (const char* file : {"nosnoc/ocp_sliding_mode_nosnoc.toml", "ocp_sliding_mode.toml"}) {
     SCOPED_TRACE(file);
     expect_same_dynamics(fesd::load_ocp_problem(example(file)).ocp.model, 23U);
   }
@@ -322,7 +322,7 @@ TEST(HessianPasses, StageStateBlockIsBitIdenticalToAutoDiff) {
 TEST(HessianPasses, FesdNlpsMatchTheColumnPasses) {
   const fesd::Pss cpp_model = fesd_test::nonlinear_model();
   const fesd::Pss nosnoc =
-      fesd::load_ocp_problem(example("ocp_sliding_mode_nosnoc.toml")).ocp.model;
+      fesd::load_ocp_problem(example("nosnoc/ocp_sliding_mode_nosnoc.toml")).ocp.model;
   const fesd::Pss paper = fesd::load_ocp_problem(example("ocp_sliding_mode.toml")).ocp.model;
   for (const fesd::StepEq step_eq :
        {fesd::StepEq::Eta, fesd::StepEq::EtaTanh, fesd::StepEq::L2Relaxed,

@@ -276,7 +276,7 @@ INSTANTIATE_TEST_SUITE_P(Guesses, OcpElasticTwoSided, ::testing::Values(-2.7, -1
 // The sliding-mode OCP of Sect. 5.3 (nosnoc_py's settings): the objective of the default method
 // to the homotopy's tolerance.
 TEST(OcpElasticTwoSidedSliding, SameObjectiveAsTheDefault) {
-  OcpProblem q = example("ocp_sliding_mode_nosnoc.toml");
+  OcpProblem q = example("nosnoc/ocp_sliding_mode_nosnoc.toml");
   const OcpResult def = solve(q.ocp, q.options);
   q.options.homotopy.mpcc_mode = MpccMode::ElasticTwoSided;
   const OcpResult r = solve(q.ocp, q.options);

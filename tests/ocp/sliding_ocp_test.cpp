@@ -51,14 +51,14 @@ TEST(SlidingModeOcp, SwitchingSequenceOfSection53AndPiecewiseUniformGrid) {
   }
 }
 
-// REAL SOLVE (about 2 s): examples/ocp_sliding_mode_nosnoc.toml, nosnoc_py's example of (61)
+// REAL SOLVE (about 2 s): examples/nosnoc/ocp_sliding_mode_nosnoc.toml, nosnoc_py's example of (61)
 // (v' = 2u, heuristic_mean rho_h = 10), with exits free as nosnoc_py leaves them: the last NLP's
 // objective (OCP cost + step-equilibration penalty) is nosnoc_py's reported 5.596209 (PEERS.md,
 // 7 digits: tolerance 1e-6 covers its rounding and IPOPT's tolerance). The OCP cost alone is
 // fesd's own figure (docs/benchmarks-ocp.md), kept to 1e-6.
 TEST(SlidingModeOcp, NosnocExampleReachesNosnocPyObjective) {
   fesd::OcpProblem q = fesd::load_ocp_problem(std::string(FESD_SOURCE_DIR) +
-                                              "/examples/ocp_sliding_mode_nosnoc.toml");
+                                              "/examples/nosnoc/ocp_sliding_mode_nosnoc.toml");
   q.options.discretization.pin_sliding_exits = false;
   q.options.homotopy.active_set_sigma = 0;  // every NLP of nosnoc_py's homotopy
   const fesd::OcpResult r = fesd::solve(q.ocp, q.options);
@@ -78,7 +78,7 @@ TEST(SlidingModeOcp, NosnocExampleReachesNosnocPyObjective) {
 // homotopy (measured 1.1e-10 and 3e-10 apart), exact complementarity, fewer NLPs (7 against 11).
 TEST(SlidingModeOcp, StableActiveSetEndsTheHomotopyEarly) {
   fesd::OcpProblem q = fesd::load_ocp_problem(std::string(FESD_SOURCE_DIR) +
-                                              "/examples/ocp_sliding_mode_nosnoc.toml");
+                                              "/examples/nosnoc/ocp_sliding_mode_nosnoc.toml");
   ASSERT_EQ(q.options.homotopy.active_set_sigma, 1e-4);
   const fesd::OcpResult early = fesd::solve(q.ocp, q.options);
   q.options.homotopy.active_set_sigma = 0;
