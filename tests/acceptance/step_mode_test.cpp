@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <fstream>
@@ -176,12 +177,16 @@ TEST(StepMode, OscillatorExact) {
 
 // ---- an OCP: (56), the sensitivity OCP, x0* = (9 - sqrt(417)) / 8, V* = 1.5237727753749571 -----
 
-TEST(StepMode, SensitivityOcpSameObjective) {
-  fesd::OcpProblem q = fesd::load_ocp_problem(example("ocp_sensitivity.toml"));
+// The OCP of `file` solved as written (Stewart's form, .first) and in the step form (.second).
+std::pair<fesd::OcpResult, fesd::OcpResult> solve_stewart_and_step(const std::string& file) {
+  const fesd::OcpProblem q = fesd::load_ocp_problem(example(file));
   fesd::OcpProblem s = q;
   fesd::apply_override(s, "dcs_mode", "step");
-  const fesd::OcpResult a = fesd::solve(q.ocp, q.options);
-  const fesd::OcpResult b = fesd::solve(s.ocp, s.options);
+  return {fesd::solve(q.ocp, q.options), fesd::solve(s.ocp, s.options)};
+}
+
+TEST(StepMode, SensitivityOcpSameObjective) {
+  const auto [a, b] = solve_stewart_and_step("ocp_sensitivity.toml");
   ASSERT_EQ(a.status, fesd::Status::Success) << a.message;
   ASSERT_EQ(b.status, fesd::Status::Success) << b.message;
   EXPECT_NEAR(b.objective, a.objective, 1e-8);
@@ -194,11 +199,7 @@ TEST(StepMode, SensitivityOcpSameObjective) {
 // each, so both forms have the same Filippov sets; the same solution (measured: J equal to 1e-10,
 // states at the element boundaries to 1.6e-10, switch times to 3.4e-11).
 TEST(StepMode, SlidingModeOcpSameObjective) {
-  fesd::OcpProblem q = fesd::load_ocp_problem(example("nosnoc/ocp_sliding_mode_nosnoc.toml"));
-  fesd::OcpProblem s = q;
-  fesd::apply_override(s, "dcs_mode", "step");
-  const fesd::OcpResult a = fesd::solve(q.ocp, q.options);
-  const fesd::OcpResult b = fesd::solve(s.ocp, s.options);
+  const auto [a, b] = solve_stewart_and_step("nosnoc/ocp_sliding_mode_nosnoc.toml");
   ASSERT_EQ(a.status, fesd::Status::Success) << a.message;
   ASSERT_EQ(b.status, fesd::Status::Success) << b.message;
   EXPECT_NEAR(b.objective, a.objective, 1e-7);
