@@ -12,13 +12,14 @@
 //
 //   fig8_accuracy [--quick] [--methods radau_iia:3,gauss_legendre] [--N 8,16,32] [--N-low 64,128]
 //                 [--mode both|fesd|std] [--comp-tol 1e-12] [--sigma-N 1e-13] [--ipopt-tol 1e-12]
-//                 [--stage-sign auto|all|boundary]
+//                 [--stage-sign auto|all|boundary] [--dcs-mode stewart|step]
 //                 [--csv FILE] [--json FILE]
 //
 // A method is `scheme:n_s` or just `scheme` (all n_s of Fig. 8); scheme names as in problem files.
 // Methods of order >= 3 run at --N (default 8, 11, ..., 64); methods of order 1 and 2, whose error
 // constants are large on this problem, at --N-low (default 64, 128, ..., 1024; = --N if only --N
-// is given).
+// is given). `--dcs-mode step` runs the Heaviside step form (nosnoc's Step mode, as in its
+// oscillator/integration_order_experiment_oscillator.py) instead of Stewart's.
 // One progress line per run goes to stderr; the tables go to stdout.
 #include <algorithm>
 #include <cmath>
@@ -178,6 +179,7 @@ struct Config {
   double comp_tol = 1e-12, sigma_N = 1e-13, ipopt_tol = 1e-12;
   fesd::StageLambdaSign stage_sign = fesd::StageLambdaSign::Auto;
   fesd::StepSolver step_solver = fesd::IntegratorOptions{}.step_solver;  // the library's default
+  fesd::DcsMode dcs_mode = fesd::DcsMode::Stewart;
   std::string csv, json;
   bool quick = false;
 };
@@ -214,6 +216,9 @@ Config parse_args(int argc, char** argv) {
       const std::string v = value();
       if (!fesd::parse(v, cfg.stage_sign))
         usage("--stage-sign " + v + ": expected all, boundary or auto");
+    } else if (a == "--dcs-mode") {
+      const std::string v = value();
+      if (!fesd::parse(v, cfg.dcs_mode)) usage("--dcs-mode " + v + ": expected stewart or step");
     } else if (a == "--comp-tol") {
       cfg.comp_tol = parse_double(a, value());
     } else if (a == "--step-solver") {
@@ -281,6 +286,7 @@ Run run_one(const Method& m, bool use_fesd, int N_sim, const Config& cfg) {
   opt.discretization.N_FE = 2;  // as in the paper
   opt.discretization.use_fesd = use_fesd;
   opt.discretization.stage_lambda_sign = cfg.stage_sign;
+  opt.discretization.dcs_mode = cfg.dcs_mode;
   opt.homotopy.complementarity_tol = cfg.comp_tol;
   opt.homotopy.sigma_N = cfg.sigma_N;
   opt.step_solver = cfg.step_solver;
@@ -327,7 +333,7 @@ void fesd_bench::usage(const std::string& why, int exit_code) {
       "fig8_accuracy: %s\n"
       "usage: fig8_accuracy [--quick] [--methods scheme[:n_s],...] [--N n1,...] [--N-low n1,...]\n"
       "                     [--mode both|fesd|std] [--comp-tol X] [--sigma-N X]\n"
-      "                     [--stage-sign auto|all|boundary]\n"
+      "                     [--stage-sign auto|all|boundary] [--dcs-mode stewart|step]\n"
       "                     [--ipopt-tol X] [--step-solver active_set|homotopy]\n"
       "                     [--csv FILE] [--json FILE]\n"
       "schemes: radau_iia gauss_legendre lobatto_iiia lobatto_iiic explicit_rk\n",

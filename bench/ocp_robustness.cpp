@@ -93,7 +93,7 @@ std::vector<Config> method_configs() {
   using fesd::StepEq;
   std::vector<Config> out;
   for (MpccMode m : {MpccMode::ScholtesIneq, MpccMode::ScholtesEq, MpccMode::FischerBurmeister,
-                     MpccMode::L1Penalty, MpccMode::ElasticIneq})
+                     MpccMode::L1Penalty, MpccMode::ElasticIneq, MpccMode::ElasticTwoSided})
     for (StepEq e : {StepEq::L2Relaxed, StepEq::HeuristicMean, StepEq::HeuristicDelta, StepEq::Eta,
                      StepEq::None})
       for (auto init : {fesd::OcpInitialization::Constant, fesd::OcpInitialization::Simulation}) {
