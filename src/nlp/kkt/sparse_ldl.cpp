@@ -457,13 +457,6 @@ FESD_KKT_KERNEL void update_contribution(int nf, int nfs, int k, double* f, cons
   for (; j0 < nf; ++j0) contribution_block<1>(ld, k, j0, f, w + (j0 - nfs), m);
 }
 
-/// y(i) -= x(i) c for i = from .. ld, four at a time from `from` rounded down to a multiple of 4
-/// (ld is one): the entries before `from` are a front column's unused upper triangle (any finite
-/// x there is harmless).
-FESD_KKT_INLINE void axpy_down(double* y, const double* x, double c, int from, int ld) {
-  for (int i = from & ~3; i < ld; i += 4) store4(y + i, load4(y + i) - load4(x + i) * c);
-}
-
 /// sum_i x(i) y(i) over i = from .. to with four partial sums (vectorized; reassociated).
 FESD_KKT_INLINE double dot(const double* x, const double* y, int from, int to) {
   Vec4 acc = {};
@@ -521,6 +514,58 @@ struct PivotResult {
   int negative = 0;
 };
 
+/// Rows i .. i + 4R of fully summed column j (cj), updated with the pending 1x1 pivots t = base ..
+/// k - 1 in order: minus U_t L(j, t) (U_t = pivot t's column before the division by d, at u + t
+/// ld), each entry loaded and stored once.
+template <int R>
+FESD_KKT_INLINE void pending_rows_1x1(double* cj, int i, int j, int base, int k, const double* f,
+                                      const double* u, int ld) {
+  const std::size_t lds = static_cast<std::size_t>(ld);
+  Vec4 acc[R];
+  for (int r = 0; r < R; ++r) acc[r] = load4(cj + i + 4 * r);
+  const double* ut = u + base * lds + i;
+  const double* st = f + base * lds + j;
+  for (int t = base; t < k; ++t, ut += lds, st += lds)
+    for (int r = 0; r < R; ++r) acc[r] = acc[r] - load4(ut + 4 * r) * *st;
+  for (int r = 0; r < R; ++r) store4(cj + i + 4 * r, acc[r]);
+}
+
+/// Brings fully summed column j up to date with the pending pivots base .. k - 1, rows from j
+/// rounded down to a multiple of 4 to the padded end, as the right-looking update pivot by pivot
+/// did and with the same operations per entry in the same order (the same values bit for bit): a
+/// 1x1 pivot t subtracts U_t L(j, t), a 2x2 pivot (t, t + 1) L_t U_t(j) + L_t+1 U_t+1(j) (its two
+/// columns of L and of the copies before the multiplication by D^-1).
+FESD_KKT_INLINE void apply_pending(double* f, int j, int base, int k, const double* u,
+                                   const int* kind, int ld, bool all_one_by_one) {
+  const std::size_t lds = static_cast<std::size_t>(ld);
+  double* cj = f + j * lds;
+  const int i0 = j & ~3;
+  if (all_one_by_one) {
+    int i = i0;
+    for (; i + 16 <= ld; i += 16) pending_rows_1x1<4>(cj, i, j, base, k, f, u, ld);
+    if (i + 8 <= ld) {
+      pending_rows_1x1<2>(cj, i, j, base, k, f, u, ld);
+      i += 8;
+    }
+    if (i < ld) pending_rows_1x1<1>(cj, i, j, base, k, f, u, ld);
+    return;
+  }
+  for (int t = base; t < k;) {
+    if (kind[t] == 1) {
+      const double* ut = u + t * lds;
+      const double st = f[t * lds + j];
+      for (int i = i0; i < ld; i += 4) store4(cj + i, load4(cj + i) - load4(ut + i) * st);
+      t += 1;
+    } else {
+      const double *c1 = f + t * lds, *c2 = c1 + lds;
+      const double s1 = u[t * lds + j], s2 = u[(t + 1) * lds + j];
+      for (int i = i0; i < ld; i += 4)
+        store4(cj + i, load4(cj + i) - (load4(c1 + i) * s1 + load4(c2 + i) * s2));
+      t += 2;
+    }
+  }
+}
+
 /// Partial LDL' of a front whose first nfs rows are fully summed: eliminates as many of them as
 /// the threshold test allows, moving accepted pivots to the front (idx follows). On return the
 /// first nelim columns hold L (D on the diagonal, a 2x2's off-diagonal at (k+1, k)), the trailing
@@ -531,12 +576,34 @@ FESD_KKT_KERNEL PivotResult partial_ldlt(int nf, int nfs, double* storage, int* 
                                          std::vector<double>& w2) {
   Front F(storage, nf);
   const int ld = front_ld(nf);
+  const std::size_t lds = static_cast<std::size_t>(ld);
   PivotResult res;
-  grow(w1, ld);
-  grow(w2, ld);
-  int k = 0;
+  // w1: per pivot t, at t ld, its column(s) before the division by D (the pending updates).
+  grow(w1, static_cast<std::size_t>(nfs + 1) * lds);
+  double* ubuf = w1.data();
+  // Left-looking over the fully summed columns: pivots base .. k - 1 are not yet applied to the
+  // columns after k (all of them have pivots 0 .. base - 1); column k gets them before its pivot
+  // test, the others when a test fails (the search and the swaps then see every column up to
+  // date) or when they become column k. Per entry the same updates in the same order as
+  // right-looking, once loaded and stored instead of once per pivot.
+  int k = 0, base = 0, twos = 0;  // twos: 2x2 pivots among base .. k - 1
+  // (Called directly: a lambda would be compiled for the default target, without the clone's
+  // FMA, and round differently.)
   while (k < nfs) {
     int pivot_p = -1, pivot_q = -1;
+    if (base < k) apply_pending(storage, k, base, k, ubuf, kind, ld, twos == 0);
+    {
+      // Column k's 1x1 test (the usual pivot); the search below repeats it after a failure.
+      const double cmax = abs_max(F.col(k), k + 1, ld);
+      const double akk = F.at(k, k);
+      if (std::abs(akk) > tiny && std::abs(akk) >= u * cmax) pivot_p = k;
+    }
+    if (pivot_p < 0 && base < k) {
+      for (int j = k + 1; j < nfs; ++j)
+        apply_pending(storage, j, base, k, ubuf, kind, ld, twos == 0);
+      base = k;
+      twos = 0;
+    }
     for (int p = k; p < nfs && pivot_p < 0; ++p) {
       // The column maximum first (vectorized); the 2x2 partner only if the 1x1 test fails.
       double cmax = abs_max(F.col(p), p + 1, ld);
@@ -585,14 +652,13 @@ FESD_KKT_KERNEL PivotResult partial_ldlt(int nf, int nfs, double* storage, int* 
       F.swap(k, pivot_p, idx);
       const double d = F.at(k, k);
       if (d < 0) ++res.negative;
-      double* wk = w1.data();
+      double* wk = ubuf + k * lds;
       double* ck = F.col(k);
       // wk = column k below the pivot (padding rows: zero), column k = L = wk / d. Rows
-      // (k + 1) & ~3 .. k of wk get column k's diagonal and upper triangle: axpy_down adds them
-      // only to the unused upper triangle.
+      // (k + 1) & ~3 .. k of wk get column k's diagonal and upper triangle: the pending update
+      // adds them only to the unused upper triangle. The fully summed columns get it later
+      // (apply_pending), the contribution block one update at the end.
       copy_and_scale(wk, ck, d, k + 1, ld);
-      // Fully summed columns now; the contribution block gets one update at the end.
-      for (int j = k + 1; j < nfs; ++j) axpy_down(F.col(j), wk, ck[j], j, ld);
       kind[k] = 1;
       k += 1;
     } else {
@@ -608,7 +674,7 @@ FESD_KKT_KERNEL PivotResult partial_ldlt(int nf, int nfs, double* storage, int* 
       // a1, a2 = the two columns below the pivot, columns k, k + 1 = L = [a1 a2] D^-1, in vector
       // passes from k + 2 rounded down to a multiple of 4 (padding rows included: zero); the
       // first block keeps rows k, k + 1 (D) and the rows above of the columns (a lane mask).
-      double *a1 = w1.data(), *a2 = w2.data();
+      double *a1 = ubuf + k * lds, *a2 = a1 + lds;
       double* c1 = F.col(k);
       double* c2 = F.col(k + 1);
       {
@@ -631,21 +697,16 @@ FESD_KKT_KERNEL PivotResult partial_ldlt(int nf, int nfs, double* storage, int* 
           store4(c2 + i, l2);
         }
       }
-      for (int j = k + 2; j < nfs; ++j) {
-        // Rows from j rounded down: the upper triangle of column j (c1, c2 hold D and the
-        // unused upper triangle there; padding rows are zero).
-        const double s1 = a1[j], s2 = a2[j];
-        double* cj = F.col(j);
-        for (int i = j & ~3; i < ld; i += 4)
-          store4(cj + i, load4(cj + i) - (load4(c1 + i) * s1 + load4(c2 + i) * s2));
-      }
+      // The fully summed columns get it later (apply_pending: rows from j rounded down, c1, c2
+      // hold D and the unused upper triangle there; padding rows are zero).
       kind[k] = 2;
       kind[k + 1] = 0;
+      ++twos;
       k += 2;
     }
   }
   res.nelim = k;
-  if (nf > nfs && k > 0) update_contribution(nf, nfs, k, storage, kind, w1);
+  if (nf > nfs && k > 0) update_contribution(nf, nfs, k, storage, kind, w2);
   return res;
 }
 
