@@ -1,11 +1,12 @@
 // The slope table of Example 1 of papers/fesd-pds.txt (issue 16, item 3a; docs/pds.md): the
 // error ||x(T) - (-1, 0)|| of FESD and of the standard RK method (6) against h = T / N_FE, Radau
 // IIA, (a) one interval over [0, T] with N_FE elements, (b) N_sim steps of 2 elements each; with
-// least-squares slopes of log(error) over log(h) through the errors above 1e-10 (round-off and
-// the complementarity_tol 1e-9 of the homotopy lie below).
+// least-squares slopes of log(error) over log(h) through the errors above the round-off floor
+// 1e3 eps |x(T)|, printed with the range and number of points used (see fit() below).
 //
 //   pds_example1 [--ns 2,3,4] [--nfe 10,20,40,80,140,200,400] [--nsim 5,10,20,40,70,100,200]
-//                [--scheme radau_iia|lobatto_iiic]
+//                [--scheme radau_iia|lobatto_iiic] [--method fesd|standard]
+//                [--M 1e6]
 //
 // (Lobatto IIIC: n_s >= 2, expected order 2 n_s - 2.)
 // Prints one row per run (error, contact and leaving time errors for FESD, NLPs, IPOPT iterations,
@@ -14,6 +15,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -30,19 +32,74 @@ std::vector<int> parse_list(const char* s) {
   return out;
 }
 
-double slope(const std::vector<double>& h, const std::vector<double>& e) {
-  double sx = 0, sy = 0, sxx = 0, sxy = 0;
-  int n = 0;
-  for (std::size_t i = 0; i < h.size(); ++i) {
-    if (!(e[i] > 1e-10) || !std::isfinite(e[i])) continue;
-    const double x = std::log(h[i]), y = std::log(e[i]);
-    sx += x, sy += y, sxx += x * x, sxy += x * y, ++n;
+// Least-squares fit of log(err) over log(h) through the runs that solved with err above the
+// round-off floor 1e3 * eps * |x(T)| (= 2.2e-13 here; below it the error is round-off, not
+// discretization error). Reports the slope, its standard error from the residuals ("+-"), the
+// slopes of the coarser and the finer half of the points (pre-asymptotic vs. asymptotic), and the
+// range.
+struct Fit {
+  double slope = NAN, se = NAN, coarse = NAN, fine = NAN;
+  int used = 0, below_floor = 0, failed = 0, count_min = 0, count_max = 0;
+};
+
+double ls_slope(const std::vector<double>& x, const std::vector<double>& y, std::size_t b,
+                std::size_t e, double* se = nullptr) {
+  const double n = static_cast<double>(e - b);
+  if (e - b < 2) return NAN;
+  double sx = 0, sy = 0;
+  for (std::size_t i = b; i < e; ++i) sx += x[i], sy += y[i];
+  const double mx = sx / n, my = sy / n;
+  double sxx = 0, sxy = 0;
+  for (std::size_t i = b; i < e; ++i)
+    sxx += (x[i] - mx) * (x[i] - mx), sxy += (x[i] - mx) * (y[i] - my);
+  const double k = sxy / sxx;
+  if (se && e - b > 2) {
+    double ss = 0;
+    for (std::size_t i = b; i < e; ++i) ss += std::pow(y[i] - my - k * (x[i] - mx), 2);
+    *se = std::sqrt(ss / (n - 2) / sxx);
   }
-  if (n < 2) return NAN;
-  return (n * sxy - sx * sy) / (n * sxx - sx * sx);
+  return k;
+}
+
+Fit fit(const std::vector<int>& counts, const std::vector<double>& h, const std::vector<double>& e,
+        double floor) {
+  Fit f;
+  std::vector<double> x, y;
+  for (std::size_t i = 0; i < h.size(); ++i) {
+    if (!std::isfinite(e[i])) {
+      ++f.failed;
+      continue;
+    }
+    if (!(e[i] > floor)) {
+      ++f.below_floor;
+      continue;
+    }
+    if (x.empty()) f.count_min = counts[i];
+    f.count_max = counts[i];
+    x.push_back(std::log(h[i]));
+    y.push_back(std::log(e[i]));
+  }
+  f.used = static_cast<int>(x.size());
+  f.slope = ls_slope(x, y, 0, x.size(), &f.se);
+  if (x.size() >= 6) {
+    f.coarse = ls_slope(x, y, 0, x.size() / 2);
+    f.fine = ls_slope(x, y, x.size() / 2, x.size());
+  }
+  return f;
+}
+
+void print_fit(const char* name, const Fit& f, const std::string& expected, bool per_step) {
+  std::printf("     %-8s slope %.2f +- %.2f (%s), %s %d..%d, %d points used", name, f.slope, f.se,
+              expected.c_str(), per_step ? "N_sim" : "N_FE", f.count_min, f.count_max, f.used);
+  if (f.below_floor) std::printf(", %d below round-off", f.below_floor);
+  if (f.failed) std::printf(", %d failed", f.failed);
+  if (std::isfinite(f.coarse))
+    std::printf("; coarser half %.2f, finer half %.2f", f.coarse, f.fine);
+  std::printf("\n");
 }
 
 fesd::RkScheme g_scheme = fesd::RkScheme::RadauIIA;
+fesd::PdsOptions g_pds;
 
 struct Run {
   double err = NAN, contact = NAN, leave = NAN, wall = 0;
@@ -58,8 +115,8 @@ Run run(int n_s, int N_FE, int N_sim, bool fesd) {
   o.discretization.use_fesd = fesd;
   Run r;
   const auto t0 = std::chrono::steady_clock::now();
-  const auto res =
-      fesd::integrate(pds_example1::model(), pds_example1::x0(), pds_example1::kT, N_sim, o);
+  const auto res = fesd::integrate(pds_example1::model(), pds_example1::x0(), pds_example1::kT,
+                                   N_sim, o, {}, {}, g_pds);
   r.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   r.ok = res.status == fesd::Status::Success;
   r.nlps = res.summary.homotopy_steps;
@@ -73,30 +130,38 @@ Run run(int n_s, int N_FE, int N_sim, bool fesd) {
   return r;
 }
 
+bool g_fesd = true, g_standard = true;
+
 void table(const char* title, const std::vector<int>& n_s_list, const std::vector<int>& counts,
            bool per_step) {
   std::printf("\n%s\n", title);
   std::printf("%4s %6s %10s | %10s %9s %9s %5s %6s %7s | %10s %5s %6s %7s\n", "n_s",
               per_step ? "N_sim" : "N_FE", "h", "FESD err", "t_c err", "t_l err", "NLPs", "iters",
               "s", "std err", "NLPs", "iters", "s");
+  const double floor = 1e3 * std::numeric_limits<double>::epsilon() * pds_example1::x_T().norm();
   for (int n_s : n_s_list) {
     std::vector<double> hs, ef, es;
     for (int count : counts) {
       const int N_FE = per_step ? 2 : count, N_sim = per_step ? count : 1;
       const double h = pds_example1::kT / (N_FE * N_sim);
-      const Run f = run(n_s, N_FE, N_sim, true);
-      const Run s = run(n_s, N_FE, N_sim, false);
+      const Run f = g_fesd ? run(n_s, N_FE, N_sim, true) : Run{};
+      const Run s = g_standard ? run(n_s, N_FE, N_sim, false) : Run{};
+      const bool failed = (g_fesd && !f.ok) || (g_standard && !s.ok);
       std::printf("%4d %6d %10.3e | %10.3e %9.2e %9.2e %5d %6d %7.2f | %10.3e %5d %6d %7.2f%s\n",
                   n_s, count, h, f.err, f.contact, f.leave, f.nlps, f.iters, f.wall, s.err, s.nlps,
-                  s.iters, s.wall, f.ok && s.ok ? "" : "  (failed run: err nan)");
+                  s.iters, s.wall, failed ? "  (failed run: err nan)" : "");
       hs.push_back(h);
       ef.push_back(f.err);
       es.push_back(s.err);
       std::fflush(stdout);
     }
     const int order = g_scheme == fesd::RkScheme::LobattoIIIC ? 2 * n_s - 2 : 2 * n_s - 1;
-    std::printf("     n_s = %d: slope FESD %.2f (order %d), standard %.2f\n", n_s, slope(hs, ef),
-                order, slope(hs, es));
+    std::printf("     n_s = %d, fit through err > %.1e (1e3 eps |x(T)|):\n", n_s, floor);
+    if (g_fesd)
+      print_fit("FESD", fit(counts, hs, ef, floor), "expected " + std::to_string(order), per_step);
+    if (g_standard)
+      print_fit("standard", fit(counts, hs, es, floor),
+                "paper's Fig. 2: between 1 and 2 (min(2, order) at most)", per_step);
   }
 }
 
@@ -112,6 +177,12 @@ int main(int argc, char** argv) {
       nfe = parse_list(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--nsim"))
       nsim = parse_list(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--M"))
+      g_pds.M = std::stod(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--method") && !std::strcmp(argv[i + 1], "fesd"))
+      g_standard = false;
+    else if (!std::strcmp(argv[i], "--method") && !std::strcmp(argv[i + 1], "standard"))
+      g_fesd = false;
     else if (!std::strcmp(argv[i], "--scheme") && !std::strcmp(argv[i + 1], "lobatto_iiic"))
       g_scheme = fesd::RkScheme::LobattoIIIC;
     else if (!std::strcmp(argv[i], "--scheme") && !std::strcmp(argv[i + 1], "radau_iia"))
