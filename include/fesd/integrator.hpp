@@ -93,6 +93,8 @@ struct IntegratorResult {
   /// The step form's stage values (dcs_mode = step, else empty): alpha, lambda_p, lambda_n per
   /// switching function (n_c each), at the same stage points.
   std::vector<Eigen::VectorXd> alpha, lambda_p, lambda_n;
+  /// The algebraic variables z at the same stage points (models with z, else empty).
+  std::vector<Eigen::VectorXd> z;
 
   /// Active regions per element (global region indices, sorted), size N_sim * N_FE.
   std::vector<std::vector<int>> active_set;

@@ -11,18 +11,21 @@
 // User functions are templates on the scalar type (see ad.hpp) so that fesd can differentiate
 // them exactly. A C++ model is a struct with these members (only those its subsystems need):
 //
-//   template <class T> void c(const T* x, const T* p, T* c) const;   // all c-form subsystems' c, concatenated
-//   template <class T> void g(const T* x, const T* p, T* g) const;   // all g-form subsystems' g, concatenated
-//   template <class T> void f(int region, const T* x, const T* u, const T* p, T* f_out) const;
+//   template <class T> void c(const T* x, const T* p, T* c) const;   // all c-form subsystems' c,
+//   concatenated template <class T> void g(const T* x, const T* p, T* g) const;   // all g-form
+//   subsystems' g, concatenated template <class T> void f(int region, const T* x, const T* u, const
+//   T* p, T* f_out) const;
 //
 // `region` counts regions over all subsystems in order (subsystem 0's regions first). Example
 // (x' in 2 - sign(x), Example 3(a)):
 //
 //   struct TwoSided {
 //     template <class T> void c(const T* x, const T*, T* c) const { c[0] = x[0]; }
-//     template <class T> void f(int r, const T*, const T*, const T*, T* f) const { f[0] = T(r == 0 ? 1.0 : 3.0); }
+//     template <class T> void f(int r, const T*, const T*, const T*, T* f) const { f[0] = T(r == 0
+//     ? 1.0 : 3.0); }
 //   };
-//   fesd::Pss model = fesd::make_pss(TwoSided{}, fesd::PssDims{.n_x = 1, .subsystems = {fesd::Subsystem::from_c(1)}});
+//   fesd::Pss model = fesd::make_pss(TwoSided{}, fesd::PssDims{.n_x = 1, .subsystems =
+//   {fesd::Subsystem::from_c(1)}});
 //
 // With the default sign matrix for n_c = 1, S = [[1], [-1]]: region 0 is c > 0, region 1 is c < 0.
 #pragma once
@@ -65,12 +68,19 @@ struct PssDims {
 class PssFunctions {
  public:
   virtual ~PssFunctions() = default;
-#define FESD_DECLARE_PSS_FUNCTIONS(T)                                                   \
-  virtual void c(const T* x, const T* p, T* c_out) const = 0;                          \
-  virtual void g(const T* x, const T* p, T* g_out) const = 0;                          \
+#define FESD_DECLARE_PSS_FUNCTIONS(T)                         \
+  virtual void c(const T* x, const T* p, T* c_out) const = 0; \
+  virtual void g(const T* x, const T* p, T* g_out) const = 0; \
   virtual void f(int region, const T* x, const T* u, const T* p, T* f_out) const = 0;
   FESD_FOR_EACH_SCALAR(FESD_DECLARE_PSS_FUNCTIONS)
 #undef FESD_DECLARE_PSS_FUNCTIONS
+  /// Algebraic variables z (problem files' z, g_z; 0 for C++ models, which compute what they need
+  /// inside c, g and f): the number of them and their values z(x, u, p) (u may be null: zeros).
+  virtual int n_z() const {
+    return 0;
+  }
+  virtual void algebraic(const double* /*x*/, const double* /*u*/, const double* /*p*/,
+                         double* /*z*/) const {}
 };
 
 /// A piecewise smooth system in Stewart form. Cheap to copy (shares its functions).
@@ -89,6 +99,8 @@ class Pss {
   int n_theta() const { return n_theta_; }
   int n_c() const { return n_c_; }  // switching functions over all subsystems
   int n_g() const { return n_g_; }  // direct indicator functions over all subsystems
+  /// Algebraic variables z (PssFunctions::n_z; results report z at the stage points).
+  int n_z() const { return functions_ ? functions_->n_z() : 0; }
   /// First region index of subsystem k; regions of k are [region_offset(k), region_offset(k+1)).
   int region_offset(int k) const { return region_offset_[k]; }
   /// The sign matrix of subsystem k (filled in if it was given empty). Empty for g-form.
@@ -96,7 +108,7 @@ class Pss {
   const PssFunctions& functions() const { return *functions_; }
 
   /// Optional names (for messages, results and plots); defaults x1.., u1.., p1...
-  std::vector<std::string> state_names, control_names, parameter_names;
+  std::vector<std::string> state_names, control_names, parameter_names, algebraic_names;
   /// Parameter values used when the caller passes none.
   Eigen::VectorXd p_default;
 
@@ -117,15 +129,15 @@ template <class Model>
 class PssFunctionsFor final : public PssFunctions {
  public:
   explicit PssFunctionsFor(Model m) : m_(std::move(m)) {}
-#define FESD_IMPLEMENT_PSS_FUNCTIONS(T)                                                  \
-  void c(const T* x, const T* p, T* c_out) const override {                             \
-    if constexpr (requires { m_.c(x, p, c_out); }) m_.c(x, p, c_out);                   \
-  }                                                                                     \
-  void g(const T* x, const T* p, T* g_out) const override {                             \
-    if constexpr (requires { m_.g(x, p, g_out); }) m_.g(x, p, g_out);                   \
-  }                                                                                     \
-  void f(int region, const T* x, const T* u, const T* p, T* f_out) const override {     \
-    m_.f(region, x, u, p, f_out);                                                       \
+#define FESD_IMPLEMENT_PSS_FUNCTIONS(T)                                             \
+  void c(const T* x, const T* p, T* c_out) const override {                         \
+    if constexpr (requires { m_.c(x, p, c_out); }) m_.c(x, p, c_out);               \
+  }                                                                                 \
+  void g(const T* x, const T* p, T* g_out) const override {                         \
+    if constexpr (requires { m_.g(x, p, g_out); }) m_.g(x, p, g_out);               \
+  }                                                                                 \
+  void f(int region, const T* x, const T* u, const T* p, T* f_out) const override { \
+    m_.f(region, x, u, p, f_out);                                                   \
   }
   FESD_FOR_EACH_SCALAR(FESD_IMPLEMENT_PSS_FUNCTIONS)
 #undef FESD_IMPLEMENT_PSS_FUNCTIONS

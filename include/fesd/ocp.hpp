@@ -214,6 +214,8 @@ struct OcpResult {
   /// The step form's stage values (dcs_mode = step, else empty): alpha, lambda_p, lambda_n (n_c
   /// each); theta is then theta(alpha), lambda per region as in IntegratorResult.
   std::vector<Eigen::VectorXd> alpha, lambda_p, lambda_n;
+  /// The algebraic variables z at the stage points (models with z, else empty).
+  std::vector<Eigen::VectorXd> z;
 
   /// Values of the global decision variables (OcpData::v_global, in its order) and their
   /// parameter names.

@@ -86,6 +86,8 @@ class FesdInterval {
 
   // ---- layout (valid after build); n: element, m: stage 0..n_s-1, i: state, r: region ----
   int N_FE() const { return N_FE_; }
+  /// The inputs given to build().
+  const IntervalInputs& inputs() const { return in_; }
   int n_s() const { return n_s_; }
   int x(int n, int i) const { return x_[n][i]; }  ///< n = 0..N_FE (n = 0: s0)
   int h(int n) const { return h_[n]; }
@@ -296,6 +298,16 @@ template <class Result>
 void append_stage_multipliers(const FesdInterval& iv, const Pss& model,
                               const std::vector<double>& w, int n, int m, Result& res) {
   const int n_th = model.n_theta();
+  if (model.n_z() > 0) {  // the algebraic variables z(X_{n,m}, q, p)
+    const IntervalInputs& in = iv.inputs();
+    std::vector<double> x(static_cast<std::size_t>(model.n_x())), q, p;
+    for (int i = 0; i < model.n_x(); ++i) x[static_cast<std::size_t>(i)] = w[iv.X(n, m, i)];
+    for (int j : in.q) q.push_back(w[j]);
+    for (int j : in.p) p.push_back(w[j]);
+    Eigen::VectorXd z(model.n_z());
+    model.functions().algebraic(x.data(), q.empty() ? nullptr : q.data(), p.data(), z.data());
+    res.z.push_back(z);
+  }
   if (iv.step_mode()) {
     Eigen::VectorXd lam(n_th);
     for (int r = 0; r < n_th; ++r) lam[r] = iv.region_lambda(w.data(), n, m, r);

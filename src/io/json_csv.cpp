@@ -281,6 +281,10 @@ void json_of_simulation(const IntegratorResult& result, const Model& model,
     j["lambda_p"] = rows(result.lambda_p);
     j["lambda_n"] = rows(result.lambda_n);
   }
+  if (!result.z.empty()) {  // algebraic variables z at the stage points
+    j["z"] = rows(result.z);
+    if constexpr (requires { model.algebraic_names; }) j["algebraic_names"] = model.algebraic_names;
+  }
   j["active_set"] = result.active_set;
   j["switches"] = switches(result.switches);
   j["homotopy"] = homotopy(result.homotopy);
@@ -371,6 +375,10 @@ void json_of_ocp(const OcpResult& result, const Model& model, const std::string&
     j["alpha"] = rows(result.alpha);
     j["lambda_p"] = rows(result.lambda_p);
     j["lambda_n"] = rows(result.lambda_n);
+  }
+  if (!result.z.empty()) {  // algebraic variables z at the stage points
+    j["z"] = rows(result.z);
+    if constexpr (requires { model.algebraic_names; }) j["algebraic_names"] = model.algebraic_names;
   }
   j["active_set"] = result.active_set;
   j["switches"] = switches(result.switches);

@@ -57,6 +57,10 @@ void ExpressionOcpFunctions::eval(const expr::Expression* list, int n, const T* 
   for (int i = layout_.n_x; i < layout_.n_x_slots; ++i) in.push_back(T(0.0));
   for (int i = 0; i < layout_.n_u; ++i) in.push_back(u != nullptr ? u[i] : T(0.0));
   for (int i = 0; i < layout_.n_p; ++i) in.push_back(p[i]);
+  if (layout_.algebraic) {  // z(x, u, p) from g_z = 0 (model/algebraic.hpp)
+    for (int i = 0; i < layout_.n_z(); ++i) in.push_back(T(0.0));
+    layout_.algebraic->solve<T>(in.data());
+  }
   const T* symbols = in.data();
   for (int i = 0; i < n; ++i) out[i] = list[i].template evaluate<T>(symbols);
 }

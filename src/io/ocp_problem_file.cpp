@@ -373,6 +373,7 @@ OcpProblem parse_ocp_problem(std::string_view toml_text, std::string_view source
   layout.n_x_slots = n_x_user + (sym.time_index >= 0 ? 1 : 0);
   layout.n_u = n_u;
   layout.n_p = ocp.model.n_p();
+  layout.algebraic = built.algebraic;  // the expressions may read z
   ocp.n_g_path = static_cast<int>(e.g_path.size());
   ocp.n_g_terminal = static_cast<int>(e.g_terminal.size());
   ocp.n_g_path_comp = static_cast<int>(e.g_path_comp.size()) / 2;

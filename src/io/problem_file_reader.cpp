@@ -17,8 +17,8 @@ namespace {
 constexpr std::array<std::string_view, 13> kReservedNames{
     "sin", "cos", "tan", "exp", "log", "sqrt", "tanh", "abs", "sinh", "cosh", "atan", "pow", "pi"};
 
-constexpr std::array<std::string_view, 9> kModelKeys{"x", "u", "p",  "c",        "S",
-                                                     "F", "g", "x0", "subsystem"};
+constexpr std::array<std::string_view, 12> kModelKeys{"x", "u",  "p",         "c", "S",  "F",
+                                                      "g", "x0", "subsystem", "z", "z0", "g_z"};
 constexpr std::array<std::string_view, 4> kSubsystemKeys{"c", "S", "g", "F"};
 
 std::string lower(std::string_view s) {
@@ -72,7 +72,7 @@ void check_names(const Reader& r,
              fmt::format("'t' is the time; only a state may be named t (got a {} named t)", kind));
     if (!seen.insert(name).second)
       r.fail(node->source(), p,
-             fmt::format("duplicate name '{}' (names must be unique across x, u and p)",
+             fmt::format("duplicate name '{}' (names must be unique across x, u, p and z)",
                          expr::shorten(name)));
   }
 }
@@ -376,10 +376,20 @@ void check_no_controls(const Reader& r, const expr::Expression& e, const toml::n
              fmt::format("{} cannot depend on controls (expected a function of x and p, got "
                          "control '{}' in \"{}\")",
                          what, sym.u[j], expr::shorten(e.text())));
+  if (sym.z_control.empty()) return;
+  for (std::size_t j = 0; j < sym.z.size(); ++j)
+    if (e.depends_on(sym.first_z() + static_cast<int>(j)))
+      r.fail(n.source(), path,
+             fmt::format("{} cannot depend on controls (expected a function of x and p, got "
+                         "algebraic variable '{}' in \"{}\", and g_z reads control '{}')",
+                         what, sym.z[j], expr::shorten(e.text()), sym.z_control));
 }
 
 bool ModelSpec::uses_time() const {
   if (sym.time_index < 0) return false;
+  if (std::any_of(g_z.begin(), g_z.end(),
+                  [&](const expr::Expression& e) { return e.depends_on(sym.time_index); }))
+    return true;
   return std::any_of(subsystems.begin(), subsystems.end(),
                      [&](const RawSubsystem& s) { return uses_symbol(s, sym.time_index); });
 }
@@ -420,10 +430,20 @@ ModelSpec read_model_spec(const Reader& r, const toml::table& root) {
     }
   }
   check_names(r, p_names, "model.p", "parameter", seen, false);
+  std::vector<std::pair<std::string, const toml::node*>> z_names;
+  const toml::node* z_node = model.get("z");
+  if (z_node != nullptr) {
+    z_names = r.names(*z_node, "model.z");
+    if (z_names.empty())
+      r.fail(z_node->source(), "model.z",
+             "no algebraic variables (expected at least one name, or no key z)");
+  }
+  check_names(r, z_names, "model.z", "algebraic variable", seen, false);
 
   for (const auto& n : x_names) sym.x.push_back(n.first);
   for (const auto& n : u_names) sym.u.push_back(n.first);
   for (const auto& n : p_names) sym.p.push_back(n.first);
+  for (const auto& n : z_names) sym.z.push_back(n.first);
   sym.all = sym.x;
   if (std::find(sym.x.begin(), sym.x.end(), "t") == sym.x.end()) {
     sym.time_index = static_cast<int>(sym.all.size());
@@ -431,6 +451,48 @@ ModelSpec read_model_spec(const Reader& r, const toml::table& root) {
   }
   sym.all.insert(sym.all.end(), sym.u.begin(), sym.u.end());
   sym.all.insert(sym.all.end(), sym.p.begin(), sym.p.end());
+  sym.all.insert(sym.all.end(), sym.z.begin(), sym.z.end());
+
+  // Algebraic equations g_z(x, u, p, z) = 0 and Newton's start z0.
+  const toml::node* g_z_node = model.get("g_z");
+  const toml::node* z0_node = model.get("z0");
+  if (z_node == nullptr) {
+    if (g_z_node != nullptr)
+      r.fail(g_z_node->source(), "model.g_z",
+             "algebraic equations without algebraic variables (expected their names, z = [...])");
+    if (z0_node != nullptr)
+      r.fail(z0_node->source(), "model.z0",
+             "a guess of algebraic variables, but there are none (expected their names, z = "
+             "[...], and equations g_z = [...])");
+  } else {
+    const int n_z = static_cast<int>(sym.z.size());
+    if (g_z_node == nullptr)
+      r.fail(z_node->source(), "model",
+             fmt::format("missing key 'g_z' (expected {}, the algebraic equations g_z(x, u, p, "
+                         "z) = 0 of z)",
+                         count(static_cast<std::size_t>(n_z), "expression")));
+    const toml::array& a = r.array(*g_z_node, "model.g_z", "an array of expressions");
+    if (static_cast<int>(a.size()) != n_z)
+      r.fail(g_z_node->source(), "model.g_z",
+             fmt::format("wrong length (expected {}, one per algebraic variable in z, got {})",
+                         count(static_cast<std::size_t>(n_z), "expression"), a.size()));
+    const int first_z = sym.first_z();
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      spec.g_z.push_back(r.expression(a[i], index("model.g_z", i), sym.all));
+      for (std::size_t j = 0; j < sym.u.size() && sym.z_control.empty(); ++j)
+        if (spec.g_z.back().depends_on(sym.first_u() + static_cast<int>(j)))
+          sym.z_control = sym.u[j];
+    }
+    bool reads_z = false;
+    for (const expr::Expression& e : spec.g_z)
+      for (int j = 0; j < n_z; ++j) reads_z = reads_z || e.depends_on(first_z + j);
+    if (!reads_z)
+      r.fail(g_z_node->source(), "model.g_z",
+             "no equation reads z (expected g_z(x, u, p, z) = 0 to determine z)");
+    spec.z0 = Eigen::VectorXd::Zero(n_z);
+    if (z0_node != nullptr)
+      spec.z0 = r.vector(*z0_node, "model.z0", n_z, "one per algebraic variable in z");
+  }
 
   // Regions and vector fields: directly in [model] or in [[model.subsystem]].
   if (const toml::node* sub = model.get("subsystem")) {
@@ -500,6 +562,10 @@ BuiltModel build_model(const Reader& r, ModelSpec spec, bool has_clock, double t
   layout.n_x_slots = n_x_user + (sym.time_index >= 0 ? 1 : 0);
   layout.n_u = dims.n_u;
   layout.n_p = dims.n_p;
+  if (!sym.z.empty())
+    layout.algebraic = std::make_shared<const AlgebraicEquations>(
+        layout.n_x_slots + layout.n_u + layout.n_p, std::move(spec.g_z), spec.z0);
+  out.algebraic = layout.algebraic;
   try {
     out.model = make_expression_pss(std::move(dims), layout, std::move(expressions));
   } catch (const InvalidModel& e) {
@@ -509,6 +575,7 @@ BuiltModel build_model(const Reader& r, ModelSpec spec, bool has_clock, double t
   if (has_clock) out.model.state_names.push_back("t");
   out.model.control_names = sym.u;
   out.model.parameter_names = sym.p;
+  out.model.algebraic_names = sym.z;
   out.p = Eigen::Map<const Eigen::VectorXd>(spec.p_values.data(),
                                             static_cast<Eigen::Index>(spec.p_values.size()));
   out.model.p_default = out.p;

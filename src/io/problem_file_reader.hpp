@@ -189,10 +189,14 @@ void read_name(const Reader& r, const toml::table& root, std::string_view source
 
 /// Names and their symbol layout: [x..., ("t"), u..., p...].
 struct Symbols {
-  std::vector<std::string> x, u, p;
+  std::vector<std::string> x, u, p, z;  // z: algebraic variables, after p
   std::vector<std::string> all;
   int time_index = -1;  // index of the time slot "t", -1 if a state is named t
+  /// The equations g_z read a control: then z depends on u, and what gets no u (c, g, the Mayer
+  /// term, terminal constraints) must not read z.
+  std::string z_control;  // the first control g_z reads ("": none)
   int first_u() const { return static_cast<int>(x.size()) + (time_index >= 0 ? 1 : 0); }
+  int first_z() const { return first_u() + static_cast<int>(u.size() + p.size()); }
 };
 
 /// One subsystem as read: its expressions, sign matrix (empty: all 2^n_c rows) and regions.
@@ -208,7 +212,10 @@ struct ModelSpec {
   Symbols sym;
   std::vector<double> p_values;
   std::vector<RawSubsystem> subsystems;
-  /// Whether some c, g or F expression reads the time `t` (then a clock state is needed).
+  /// Algebraic equations g_z (one per name in sym.z) and Newton's start z0 (default zeros).
+  std::vector<expr::Expression> g_z;
+  Eigen::VectorXd z0;
+  /// Whether some c, g, F or g_z expression reads the time `t` (then a clock state is needed).
   bool uses_time() const;
 };
 
@@ -218,6 +225,8 @@ ModelSpec read_model_spec(const Reader& r, const toml::table& root);
 /// The Pss of a ModelSpec, with x0 and the parameter values.
 struct BuiltModel {
   Pss model;
+  /// The algebraic equations (null without z): the [ocp] expressions read z too.
+  std::shared_ptr<const AlgebraicEquations> algebraic;
   Eigen::VectorXd x0;  ///< [model] x0, with t0 appended if there is a clock
   Eigen::VectorXd p;
 };

@@ -132,6 +132,10 @@ void ExpressionModel::eval_list(const std::vector<expr::Expression>& list, const
   else
     in.push_zeros(layout_.n_u);
   in.push_range(p, layout_.n_p);
+  if (layout_.algebraic) {
+    in.push_zeros(layout_.n_z());
+    layout_.algebraic->solve<T>(in.data());
+  }
   const T* symbols = in.data();
   for (std::size_t i = 0; i < list.size(); ++i) out[i] = list[i].template evaluate<T>(symbols);
 }
@@ -148,6 +152,22 @@ void ExpressionModel::eval_list(const std::vector<expr::Expression>& list, const
   }
 FESD_FOR_EACH_SCALAR(FESD_DEFINE_EXPRESSION_FUNCTIONS)
 #undef FESD_DEFINE_EXPRESSION_FUNCTIONS
+
+void ExpressionModel::algebraic(const double* x, const double* u, const double* p,
+                                double* z) const {
+  if (!layout_.algebraic) return;
+  SymbolBuffer<double> in(layout_.n_symbols());
+  in.push_range(x, layout_.n_x);
+  in.push_zeros(layout_.n_x_slots - layout_.n_x);
+  if (u != nullptr)
+    in.push_range(u, layout_.n_u);
+  else
+    in.push_zeros(layout_.n_u);
+  in.push_range(p, layout_.n_p);
+  in.push_zeros(layout_.n_z());
+  layout_.algebraic->solve<double>(in.data());
+  std::copy_n(in.data() + layout_.n_symbols() - layout_.n_z(), layout_.n_z(), z);
+}
 
 Pss make_expression_pss(PssDims dims, ExpressionLayout layout,
                         std::vector<ExpressionSubsystem> subsystems) {

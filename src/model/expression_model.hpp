@@ -3,7 +3,11 @@
 //
 // Every expression reads one input vector, the symbols in this order:
 //
-//   [ x_0 .. x_{n_x_slots-1},  u_0 .. u_{n_u-1},  p_0 .. p_{n_p-1} ]
+//   [ x_0 .. x_{n_x_slots-1},  u_0 .. u_{n_u-1},  p_0 .. p_{n_p-1},  z_0 .. z_{n_z-1} ]
+//
+// z are the user's algebraic variables (model/algebraic.hpp): their slots are filled with the
+// solution of g_z = 0 at (x, u, p) before each evaluation. c and g get no u: if they read z, the
+// reader makes sure that g_z reads no control.
 //
 // n_x_slots is n_x or n_x + 1: the problem-file reader always offers the time `t` as the symbol
 // after the states; if no expression reads it, the model has no clock state and that slot holds 0.
@@ -16,6 +20,7 @@
 #include <vector>
 
 #include "fesd/model.hpp"
+#include "model/algebraic.hpp"
 #include "model/expression.hpp"
 
 namespace fesd {
@@ -34,7 +39,10 @@ struct ExpressionLayout {
   int n_x_slots = 0;  ///< state slots in the symbol vector: n_x or n_x + 1 (unused time slot)
   int n_u = 0;
   int n_p = 0;
-  int n_symbols() const { return n_x_slots + n_u + n_p; }
+  /// The algebraic variables z and their equations g_z (null: none).
+  std::shared_ptr<const AlgebraicEquations> algebraic{};
+  int n_z() const { return algebraic ? algebraic->n_z() : 0; }
+  int n_symbols() const { return n_x_slots + n_u + n_p + n_z(); }
 };
 
 /// fesd::PssFunctions evaluating parsed expressions, for every scalar type. c and g must not read
@@ -58,6 +66,10 @@ class ExpressionModel final : public PssFunctions {
   void f(int region, const T* x, const T* u, const T* p, T* f_out) const override;
   FESD_FOR_EACH_SCALAR(FESD_DECLARE_EXPRESSION_FUNCTIONS)
 #undef FESD_DECLARE_EXPRESSION_FUNCTIONS
+  int n_z() const override {
+    return layout_.n_z();
+  }
+  void algebraic(const double* x, const double* u, const double* p, double* z) const override;
 
  private:
   template <class T>

@@ -35,6 +35,13 @@ class SpeedOfTimePss final : public PssFunctions {
   }
   FESD_FOR_EACH_SCALAR(FESD_SPEED_OF_TIME_PSS)
 #undef FESD_SPEED_OF_TIME_PSS
+  int n_z() const override {
+    return model_.n_z();
+  }
+  void algebraic(const double* x, const double* u, const double* p, double* z) const override {
+    model_.functions().algebraic(x, u, p, z);
+  }
+
  private:
   Pss model_;  // shares the user's functions
   int n_p_, n_x_;
