@@ -142,6 +142,30 @@ struct OcpData {
   double s_sot_min = 0.04;  ///< lower bound of s, > 0 (nosnoc: s_sot_min)
   double s_sot_max = 25;    ///< upper bound of s (nosnoc: s_sot_max)
   double s_sot0 = 1;        ///< initial guess of s, within the bounds (nosnoc: s_sot0)
+  /// Weight of the penalty rho_sot sum_k (s_k - 1)^2 on the speed of time (one term per speed
+  /// variable: per control interval, or once for a global speed), >= 0 (MATLAB nosnoc: rho_sot
+  /// with S_sot_nominal = 1). Part of the objective. With time_optimal_problem or time_freezing.
+  double rho_sot = 0;
+  /// Bounds of the final time T_final = sum_k s_k T / N_stages of a time-optimal problem
+  /// (nosnoc: T_final_min, T_final_max); 0 <= T_final_min <= T_final_max.
+  double T_final_min = 0;
+  double T_final_max = std::numeric_limits<double>::infinity();
+
+  /// Time freezing (nosnoc: time_freezing): the model has a clock state x[clock_state] that
+  /// reads the physical time (t' = 1 where time runs, t' = 0 in the auxiliary regions of a state
+  /// jump). The dynamics are scaled by a speed of time s (as for time_optimal_problem: one
+  /// variable, or one per control interval with local_speed_of_time_variable) on the numerical
+  /// horizon tau in [0, T], the Lagrange term becomes s f_q, and at the end of every control
+  /// interval k = 1..N_stages the clock is tied to the physical time:
+  ///   |t(tau_k) - t(0) - k T / N_stages| <= time_freezing_tolerance.
+  /// The final time is not free: the physical horizon is T. Not with time_optimal_problem.
+  bool time_freezing = false;
+  int clock_state = -1;  ///< index of the clock state in x (nosnoc: t_var)
+  /// With time_freezing: false leaves out fesd's speed of time (nosnoc_py's
+  /// SpeedOfTimeVariableMode NONE; MATLAB nosnoc: use_speed_of_time_variables): the model
+  /// scales its dynamics itself, e.g. by a control. Must be true with time_optimal_problem.
+  bool use_speed_of_time_variables = true;
+  double time_freezing_tolerance = 0;  ///< >= 0 (nosnoc_py: time_freezing_tolerance)
 };
 
 /// An optimal control problem of a piecewise smooth system (Filippov paper, Sect. 5).
@@ -222,8 +246,10 @@ struct OcpResult {
   Eigen::VectorXd v_global;
   std::vector<std::string> v_global_names;
   /// The final time (time_optimal_problem: T_final = sum_k s_k T / N_stages; else T), and the
-  /// speed of time of every control interval (empty without time_optimal_problem). t, h, t_ctrl,
-  /// t_stage and the switch times are physical times.
+  /// speed of time of every control interval (empty without time_optimal_problem and
+  /// time_freezing). With time_optimal_problem t, h, t_ctrl, t_stage and the switch times are
+  /// physical times; with time_freezing they are the numerical time tau in [0, T] (h the steps
+  /// in tau) and the physical time is the clock state.
   double T_final = 0;
   std::vector<double> s_sot;
 

@@ -264,6 +264,27 @@ std::vector<Option> build() {
       kOcp, "s_sot_max", ocp, "upper bound of the speed of time", "s_sot_max", kPositive));
   o.push_back(scalar<&T::ocp, &Ocp::s_sot0>(
       kOcp, "s_sot0", ocp, "initial guess of the speed of time", "s_sot0", kPositive));
+  o.push_back(scalar<&T::ocp, &Ocp::rho_sot>(
+      kOcp, "rho_sot", ocp, "weight of the penalty rho_sot (s - 1)^2 per speed of time variable",
+      "rho_sot", at_least(0)));
+  o.push_back(input(kOcp, "T_final_min", ocp,
+                    "lower bound of the final time of a time-optimal problem", "T_final_min"));
+  o.push_back(input(kOcp, "T_final_max", ocp,
+                    "upper bound of the final time of a time-optimal problem", "T_final_max"));
+  o.push_back(scalar<&T::ocp, &Ocp::time_freezing>(
+      kOcp, "time_freezing", ocp,
+      "time freezing: a speed of time scales the dynamics, the clock state reads k T / N_stages "
+      "at every control interval end",
+      "time_freezing"));
+  o.push_back(input(kOcp, "clock_state", ocp,
+                    "the state of model.x that is the clock of time freezing (a name)", "t_var"));
+  o.push_back(scalar<&T::ocp, &Ocp::use_speed_of_time_variables>(
+      kOcp, "use_speed_of_time_variables", ocp,
+      "time freezing with fesd's speed of time (false: the model scales its dynamics itself)",
+      "use_speed_of_time_variables"));
+  o.push_back(scalar<&T::ocp, &Ocp::time_freezing_tolerance>(
+      kOcp, "time_freezing_tolerance", ocp, "tolerance of the clock constraints of time freezing",
+      "time_freezing_tolerance", at_least(0)));
   o.push_back(scalar<&T::ocp_options, &OcpOptions::initialization>(kOcp, "initialization", ocp,
                                                                    "initial guess of the NLP", ""));
   o.push_back(scalar<&T::ocp_options, &OcpOptions::constraints_at_stages>(

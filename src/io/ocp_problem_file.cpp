@@ -226,6 +226,23 @@ void read_stage_data(const Reader& r, const toml::table& t, const std::vector<st
   }
 }
 
+/// clock_state (a name of model.x: its index), T_final_min, T_final_max (+-inf allowed).
+void read_time_keys(const Reader& r, const toml::table& t, Ocp& ocp) {
+  if (const toml::node* n = t.get("clock_state")) {
+    const std::string name = r.string(*n, "ocp.clock_state");
+    const std::vector<std::string>& names = ocp.model.state_names;
+    const auto it = std::find(names.begin(), names.end(), name);
+    if (it == names.end())
+      r.fail(n->source(), "ocp.clock_state",
+             fmt::format("unknown state '{}' (expected a name of [model] x)", name));
+    ocp.clock_state = static_cast<int>(it - names.begin());
+  }
+  if (const toml::node* n = t.get("T_final_min"))
+    ocp.T_final_min = r.number(*n, "ocp.T_final_min", true);
+  if (const toml::node* n = t.get("T_final_max"))
+    ocp.T_final_max = r.number(*n, "ocp.T_final_max", true);
+}
+
 /// v with `value` appended (the clock's entry).
 Eigen::VectorXd append(const Eigen::VectorXd& v, double value) {
   Eigen::VectorXd out(v.size() + 1);
@@ -383,6 +400,7 @@ OcpProblem parse_ocp_problem(std::string_view toml_text, std::string_view source
   read_ocp_bounds(r, t, n_x_user, n_u, has_clock, ocp);
   read_options(r, root, problem, [&] {
     read_stage_data(r, t, sym.p, n_x_user, n_u, has_clock, ocp, problem.options);
+    read_time_keys(r, t, ocp);
   });
   return problem;
 }

@@ -123,6 +123,10 @@ std::unique_ptr<OcpNlp> build(const Ocp& ocp, const OcpOptions& o, const StagePa
 
   ocp_detail::add_ocp_terms(mp, ocp, o, b->tab, n_x, n_u, b->s0, b->p_k, b->q, b->iv,
                             b->terminal_slacks, b->comp_points);
+  std::vector<int> clock_end;  // time freezing: the clock at every control interval's end
+  if (ocp.time_freezing)
+    for (const auto& iv : b->iv) clock_end.push_back(iv->x(iv->N_FE(), ocp.clock_state));
+  ocp_detail::add_speed_of_time_constraints(mp, ocp, b->p_k, clock_end);
   for (const auto& iv : b->iv) mp.add_complementarity(iv->groups(), iv->residual_pairs());
   mp.relax(o.homotopy.mpcc_mode);
   return b;
@@ -167,6 +171,25 @@ void guess_external(OcpNlp& b, const Ocp& ocp, const StageParameters& p) {
     for (std::size_t j = 0; j < in0.mu_start.size(); ++j) w[in0.mu_start[j]] = lp.mu[j];
   }
   for (const auto& iv : b.iv) iv->update_lifted_guess(w);
+}
+
+/// Time freezing: the clock state of the guess, where it violates the clock constraints (a
+/// constant guess), linear in tau from t(0) to t(0) + T, as if time never froze; with
+/// time_freezing_tolerance the guess at every interval end is then within the bounds.
+void guess_clock(OcpNlp& b, const Ocp& ocp) {
+  auto& w = b.mpcc.guess();
+  const int c = ocp.clock_state;
+  const double t0 = ocp.x0[c], T_k = ocp.T / ocp.N_stages;
+  for (std::size_t k = 0; k < b.iv.size(); ++k) {
+    const FesdInterval& iv = *b.iv[k];
+    const int end = iv.x(iv.N_FE(), c);
+    if (w[end] >= b.mpcc.lower(end) && w[end] <= b.mpcc.upper(end)) continue;
+    const double start = t0 + static_cast<double>(k) * T_k, h = T_k / iv.N_FE();
+    for (int n = 0; n < iv.N_FE(); ++n) {
+      for (int s = 0; s < iv.n_s(); ++s) w[iv.X(n, s, c)] = start + (n + b.tab.c(s)) * h;
+      w[iv.x(n + 1, c)] = start + (n + 1) * h;
+    }
+  }
 }
 
 /// Simulation: the FESD integrator from x0 with u_guess on the same grid (one integration step
@@ -663,6 +686,7 @@ OcpResult solve_impl(const Ocp& user, const OcpOptions& options, const std::vect
   else if (!simulated)
     guess_constant(*b, ocp, p);
   ocp_detail::guess_path_comp(*b, ocp, ocp.model.n_x(), ocp.model.n_u());
+  if (ocp.time_freezing) guess_clock(*b, ocp);
   mp.finalize();
   res.summary.warnings = warnings(options.homotopy);
   res.summary.n_variables = mp.num_variables();
@@ -717,11 +741,14 @@ OcpResult solve_impl(const Ocp& user, const OcpOptions& options, const std::vect
   extract(*b, ocp, mp.solution(), p, res);
   ocp_detail::extract_globals(user, user.model.parameter_names, b->p, mp.solution(), res);
   res.T_final = ocp.T;
-  if (ocp.time_optimal_problem) {
+  if (ocp_detail::has_speed_of_time(ocp)) {
     std::vector<double> s;
     const int i_s = ocp.model.n_p() - 1;
     for (const std::vector<int>& pk : b->p_k) s.push_back(mp.solution()[pk[i_s]]);
-    ocp_detail::to_physical_time(res, s, ocp.T / ocp.N_stages);
+    if (ocp.time_optimal_problem)
+      ocp_detail::to_physical_time(res, s, ocp.T / ocp.N_stages);
+    else
+      res.s_sot = s;  // time freezing: the grid stays in tau, the clock is the physical time
   }
   if (options.initialization == OcpInitialization::Simulation && !simulated)
     res.message += " [the initializing simulation failed or used another grid: constant guess]";

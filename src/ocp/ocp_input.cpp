@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <string_view>
 
@@ -203,6 +204,49 @@ void check_data(std::vector<std::string>& e, const OcpData& ocp, const ModelSize
                "ubg_terminal", "one per terminal constraint");
 }
 
+/// The rules of time freezing and of the speed of time's extras (rho_sot, T_final bounds) that
+/// are not a range of one option.
+void check_time_freezing(std::vector<std::string>& e, const OcpData& ocp, int n_x) {
+  constexpr double kNoBound = std::numeric_limits<double>::infinity();
+  if (ocp.time_freezing) {
+    if (ocp.clock_state < 0)
+      e.push_back(
+          "ocp.time_freezing = true: needs clock_state (the state that reads the physical time)");
+    else if (ocp.clock_state >= n_x)
+      e.push_back(fmt::format("ocp.clock_state = {}: out of range (the model has {} state{})",
+                              ocp.clock_state, n_x, n_x == 1 ? "" : "s"));
+    if (ocp.time_optimal_problem)
+      e.push_back(
+          "ocp.time_freezing = true: not supported with time_optimal_problem yet (time freezing "
+          "fixes the physical horizon to T)");
+  }
+  if (!ocp.use_speed_of_time_variables && !ocp.time_freezing)
+    e.push_back(
+        "ocp.use_speed_of_time_variables = false: used only with time_freezing (a time-optimal "
+        "problem needs its speed of time)");
+  if (!ocp.time_freezing && ocp.clock_state != -1) {
+    e.push_back(fmt::format("ocp.clock_state = {}: given but used only with time_freezing = true",
+                            ocp.clock_state));
+  }
+  if (std::isnan(ocp.T_final_min) || ocp.T_final_min < 0 || !std::isfinite(ocp.T_final_min))
+    e.push_back(fmt::format("ocp.T_final_min = {}: must be finite and >= 0", ocp.T_final_min));
+  if (std::isnan(ocp.T_final_max) || ocp.T_final_max <= 0)
+    e.push_back(fmt::format("ocp.T_final_max = {}: must be > 0 (inf: no bound)", ocp.T_final_max));
+  if (!ocp.time_optimal_problem && (ocp.T_final_min != 0 || ocp.T_final_max != kNoBound))
+    e.push_back(fmt::format("ocp.{} = {}: given but used only with time_optimal_problem",
+                            ocp.T_final_min != 0 ? "T_final_min" : "T_final_max",
+                            ocp.T_final_min != 0 ? ocp.T_final_min : ocp.T_final_max));
+  if (!(ocp.T_final_min <= ocp.T_final_max))
+    e.push_back(fmt::format("ocp.T_final_min = {} > ocp.T_final_max = {}: empty bounds",
+                            ocp.T_final_min, ocp.T_final_max));
+  if (!ocp.time_optimal_problem && !(ocp.time_freezing && ocp.use_speed_of_time_variables) &&
+      ocp.rho_sot != 0)
+    e.push_back(fmt::format(
+        "ocp.rho_sot = {}: given but used only with a speed of time (time_optimal_problem, or "
+        "time_freezing with use_speed_of_time_variables)",
+        ocp.rho_sot));
+}
+
 /// The rules common to both kinds of OCP; `data_rules` adds the model's own when the rest holds.
 template <class Problem, class DataRules>
 OcpInputErrors check_common(const Problem& ocp, const OcpOptions& options, const ModelSizes& sizes,
@@ -220,7 +264,8 @@ OcpInputErrors check_common(const Problem& ocp, const OcpOptions& options, const
   if (external && ocp.x_guess.empty())
     e.options.push_back(
         "ocp.initialization = external: needs x_guess (the states at the control grid points)");
-  if (ocp.time_optimal_problem && ocp.s_sot_min > 0 &&
+  check_time_freezing(e.options, ocp, sizes.n_x);
+  if ((ocp.time_optimal_problem || ocp.time_freezing) && ocp.s_sot_min > 0 &&
       !(ocp.s_sot_min <= ocp.s_sot0 && ocp.s_sot0 <= ocp.s_sot_max))
     e.options.push_back(fmt::format(
         "ocp.s_sot0 = {}: the guess of the speed of time must lie within [s_sot_min, s_sot_max] "
@@ -267,6 +312,7 @@ OcpInputErrors check_input(const PdsOcp& ocp, const OcpOptions& options) {
               std::pair{options.initialization == OcpInitialization::External,
                         "initialization = external (x_guess)"},
               std::pair{ocp.time_optimal_problem, "time_optimal_problem"},
+              std::pair{ocp.time_freezing, "time_freezing"},
               std::pair{ocp.n_g_path_comp > 0, "g_path_comp (path complementarity)"}})
           if (given)
             e.options.push_back(fmt::format("ocp.{}: not supported for projected models yet", key));

@@ -175,12 +175,12 @@ struct FreeParameter {
   bool per_interval;
 };
 
-/// The free parameters of an OCP with n_p parameters; with time_optimal_problem the speed of time
-/// is the last parameter (the OCP is the one with_speed_of_time() made).
+/// The free parameters of an OCP with n_p parameters; with time_optimal_problem or time_freezing
+/// the speed of time is the last parameter (the OCP is the one with_speed_of_time() made).
 inline std::vector<FreeParameter> free_parameters(const OcpData& ocp, int n_p) {
   std::vector<FreeParameter> f;
   for (const GlobalVariable& v : ocp.v_global) f.push_back({v.index, v.lb, v.ub, false});
-  if (ocp.time_optimal_problem)
+  if (ocp.time_optimal_problem || (ocp.time_freezing && ocp.use_speed_of_time_variables))
     f.push_back({n_p - 1, ocp.s_sot_min, ocp.s_sot_max, ocp.local_speed_of_time_variable});
   return f;
 }
@@ -233,6 +233,51 @@ inline void add_start_and_parameters(mpcc::Problem& mp, const OcpData& ocp,
       }
     }
     p_k.push_back(std::move(pk));
+  }
+}
+
+/// The constraints of the speed of time (the OCP with_speed_of_time() made; p_k[k].back() is the
+/// speed of control interval k):
+/// * time_optimal_problem with finite T_final bounds: T_final_min <= sum_k s_k T / N_stages <=
+///   T_final_max (one row over the distinct speed variables);
+/// * time_freezing: the clock at the end of control interval k (`clock_end[k]`, an NLP variable)
+///   within t(0) + (k + 1) T / N_stages +- time_freezing_tolerance, as bounds of that variable.
+inline void add_speed_of_time_constraints(mpcc::Problem& mp, const OcpData& ocp,
+                                          const std::vector<std::vector<int>>& p_k,
+                                          const std::vector<int>& clock_end) {
+  const double T_k = ocp.T / ocp.N_stages;
+  if (ocp.time_optimal_problem && (ocp.T_final_min > 0 || std::isfinite(ocp.T_final_max))) {
+    std::vector<int> speeds;  // distinct variables; a global speed counts N_stages times
+    std::vector<int> count;
+    for (const std::vector<int>& pk : p_k) {
+      const auto it = std::find(speeds.begin(), speeds.end(), pk.back());
+      if (it == speeds.end()) {
+        speeds.push_back(pk.back());
+        count.push_back(1);
+      } else {
+        ++count[static_cast<std::size_t>(it - speeds.begin())];
+      }
+    }
+    if (speeds.size() == 1) {  // a bound of the one speed
+      const double n = count.front() * T_k;
+      const int v = speeds.front();
+      mp.bound(
+          v, std::max(mp.lower(v), ocp.T_final_min / n),
+          std::min(mp.upper(v), std::isfinite(ocp.T_final_max) ? ocp.T_final_max / n : nlp::kInf));
+    } else {  // one speed per interval: sum_k s_k = T_final / T_k
+      mp.nlp().add_constraint(nlp::make_block(nlp::Sum{static_cast<int>(speeds.size())}), speeds,
+                              ocp.T_final_min / T_k,
+                              std::isfinite(ocp.T_final_max) ? ocp.T_final_max / T_k : nlp::kInf);
+    }
+  }
+  if (ocp.time_freezing) {
+    const double t0 = ocp.x0[ocp.clock_state];
+    const double tol = ocp.time_freezing_tolerance;
+    for (std::size_t k = 0; k < clock_end.size(); ++k) {
+      const double t_k = t0 + static_cast<double>(k + 1) * T_k;
+      const int v = clock_end[k];
+      mp.bound(v, std::max(mp.lower(v), t_k - tol), std::min(mp.upper(v), t_k + tol));
+    }
   }
 }
 

@@ -1,13 +1,18 @@
-// src/ocp/speed_of_time.hpp: time-optimal problems (OcpData::time_optimal_problem) as an OCP on
-// the nominal horizon tau in [0, T] with one more parameter, the speed of time s = dt / dtau:
+// src/ocp/speed_of_time.hpp: time-optimal problems (OcpData::time_optimal_problem) and time
+// freezing (OcpData::time_freezing) as an OCP on the nominal horizon tau in [0, T] with one more
+// parameter, the speed of time s = dt / dtau:
 //
-//   dx/dtau = s f_i(x, u, p) in every region i,   Lagrange term s (1 + f_q(x, u, p)),
+//   dx/dtau = s f_i(x, u, p) in every region i,
+//   Lagrange term s (1 + f_q(x, u, p)) (time-optimal) or s f_q(x, u, p) (time freezing),
+//                 plus rho_sot (s - 1)^2 / T_s (T_s = T / N_stages per local speed, T global),
 //
 // so that the integral of the Lagrange term is T_final + int_0^T_final f_q dt with
-// T_final = int_0^T s dtau. The switching functions c(x, p), the Mayer term and the constraints
-// do not change. s is a free parameter (ocp_terms.hpp, free_parameters): one NLP variable, or one
-// per control interval (local_speed_of_time_variable); within [s_sot_min, s_sot_max], guess s_sot0.
-// Nothing of the discretization changes: FesdInterval integrates the scaled model.
+// T_final = int_0^T s dtau (time-optimal), and the quadrature of the penalty is rho_sot (s - 1)^2
+// per speed variable (the h_n of a control interval sum to T / N_stages). The switching
+// functions c(x, p), the Mayer term and the constraints do not change. s is a free parameter
+// (ocp_terms.hpp, free_parameters): one NLP variable, or one per control interval
+// (local_speed_of_time_variable); within [s_sot_min, s_sot_max], guess s_sot0. Nothing of the
+// discretization changes: FesdInterval integrates the scaled model.
 #pragma once
 #include <memory>
 #include <utility>
@@ -47,16 +52,23 @@ class SpeedOfTimePss final : public PssFunctions {
   int n_p_, n_x_;
 };
 
-/// The OCP's functions with the Lagrange term s (1 + f_q) (s the last parameter).
+/// The OCP's functions with the Lagrange term s (1 + f_q) (time-optimal; `add_one`) or s f_q,
+/// plus rho_sot (s - 1)^2 / T_s (s the last parameter).
 class SpeedOfTimeCosts final : public OcpFunctions {
  public:
-  SpeedOfTimeCosts(std::shared_ptr<const OcpFunctions> f, int n_p) : f_(std::move(f)), n_p_(n_p) {}
-  bool has_f_q() const override { return true; }
+  SpeedOfTimeCosts(std::shared_ptr<const OcpFunctions> f, int n_p, bool add_one, double rho_sot,
+                   double T_s)
+      : f_(std::move(f)), n_p_(n_p), add_one_(add_one), weight_(rho_sot / T_s) {}
+  bool has_f_q() const override { return add_one_ || weight_ > 0 || (f_ && f_->has_f_q()); }
   bool has_f_q_T() const override { return f_ && f_->has_f_q_T(); }
 #define FESD_SPEED_OF_TIME_COSTS(T)                                             \
   T f_q(const T* x, const T* u, const T* p) const override {                    \
-    if (f_ && f_->has_f_q()) return p[n_p_] * (1.0 + f_->f_q(x, u, p));         \
-    return p[n_p_] * 1.0;                                                       \
+    const T& s = p[n_p_];                                                       \
+    T q(add_one_ ? 1.0 : 0.0);                                                  \
+    if (f_ && f_->has_f_q()) q = q + f_->f_q(x, u, p);                          \
+    T out = s * q;                                                              \
+    if (weight_ > 0) out = out + weight_ * (s - 1.0) * (s - 1.0);               \
+    return out;                                                                 \
   }                                                                             \
   T f_q_T(const T* x, const T* p) const override {                              \
     return f_ ? f_->f_q_T(x, p) : T(0.0);                                       \
@@ -75,6 +87,8 @@ class SpeedOfTimeCosts final : public OcpFunctions {
  private:
   std::shared_ptr<const OcpFunctions> f_;
   int n_p_;
+  bool add_one_;
+  double weight_;
 };
 
 inline Eigen::VectorXd with_entry(const Eigen::VectorXd& v, double value) {
@@ -83,10 +97,15 @@ inline Eigen::VectorXd with_entry(const Eigen::VectorXd& v, double value) {
   return out;
 }
 
+/// True if the OCP has a speed of time (time-optimal or time freezing).
+inline bool has_speed_of_time(const OcpData& ocp) {
+  return ocp.time_optimal_problem || (ocp.time_freezing && ocp.use_speed_of_time_variables);
+}
+
 /// The OCP on the nominal horizon with the speed of time as its last parameter (guess s_sot0);
-/// the OCP itself if it is not time-optimal.
+/// the OCP itself if it has no speed of time.
 inline Ocp with_speed_of_time(const Ocp& ocp) {
-  if (!ocp.time_optimal_problem) return ocp;
+  if (!has_speed_of_time(ocp)) return ocp;
   Ocp out = ocp;
   const Pss& m = ocp.model;
   PssDims dims = m.dims();
@@ -99,7 +118,9 @@ inline Ocp with_speed_of_time(const Ocp& ocp) {
   out.model.p_default = with_entry(m.p_default, ocp.s_sot0);
   if (ocp.p.size() > 0) out.p = with_entry(ocp.p, ocp.s_sot0);
   for (Eigen::VectorXd& row : out.p_stage) row = with_entry(row, ocp.s_sot0);
-  out.functions = std::make_shared<const SpeedOfTimeCosts>(ocp.functions, m.n_p());
+  const double T_s = ocp.local_speed_of_time_variable ? ocp.T / ocp.N_stages : ocp.T;
+  out.functions = std::make_shared<const SpeedOfTimeCosts>(
+      ocp.functions, m.n_p(), ocp.time_optimal_problem, ocp.rho_sot, T_s);
   return out;
 }
 

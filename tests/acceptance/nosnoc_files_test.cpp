@@ -202,3 +202,24 @@ TEST(NosnocFiles, CarControlComplementarityNeverThrottlesAndBrakes) {
 }
 
 }  // namespace
+
+namespace {
+
+// The time-freezing OCPs of rows 9 and 23 (docs/nosnoc-examples.md) load with their clock: the
+// state t, the temperature control with its own speed-of-time control (no fesd speed variable),
+// the ball in a box with one speed per control interval. Solving them is in the catalogue bench
+// (the temperature OCP does not converge as written, the ball takes 100 s).
+TEST(NosnocFiles, TimeFreezingOcpsLoadWithTheirClock) {
+  const fesd::OcpProblem t = fesd::load_ocp_problem(example_path("temperature_control_ocp.toml"));
+  EXPECT_TRUE(t.ocp.time_freezing);
+  EXPECT_EQ(t.ocp.clock_state, 2);
+  EXPECT_FALSE(t.ocp.use_speed_of_time_variables);
+  EXPECT_EQ(t.ocp.time_freezing_tolerance, 0.1);
+  const fesd::OcpProblem b = fesd::load_ocp_problem(example_path("elastic_ball_in_box.toml"));
+  EXPECT_TRUE(b.ocp.time_freezing);
+  EXPECT_EQ(b.ocp.clock_state, 4);
+  EXPECT_TRUE(b.ocp.local_speed_of_time_variable);
+  EXPECT_EQ(b.ocp.model.n_theta(), 9);
+}
+
+}  // namespace

@@ -1,11 +1,15 @@
 // OCP modelling features of nosnoc (issue "every nosnoc_py example", second slice): global decision
 // variables (OcpData::v_global, [ocp] v_global), time-optimal problems with a speed of time
-// (time_optimal_problem), path complementarity constraints (g_path_comp) and the two-sided elastic
-// MPCC mode (mpcc_mode = elastic_two_sided), each against a problem with a known answer
-// (examples/ocp_global_variable.toml, ocp_time_optimal.toml, ocp_path_complementarity.toml, the
-// sensitivity OCP (56) and the sliding-mode OCP of Sect. 5.3). docs/ocp-features.md.
+// (time_optimal_problem, T_final bounds, rho_sot), time freezing (time_freezing, clock_state), path
+// complementarity constraints (g_path_comp) and the two-sided elastic MPCC mode (mpcc_mode =
+// elastic_two_sided), each against a problem with a known answer
+// (examples/ocp_global_variable.toml, ocp_time_optimal.toml, ocp_time_freezing.toml,
+// ocp_path_complementarity.toml, the sensitivity OCP (56) and the sliding-mode OCP of Sect. 5.3).
+// docs/ocp-features.md.
+#include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include <fstream>
 #include <iterator>
@@ -189,6 +193,151 @@ TEST(OcpTimeOptimal, BadInput) {
   ocp = double_integrator(false);
   ocp.s_sot_min = 0;
   EXPECT_THROW(solve(ocp, OcpOptions{}), InvalidOption);
+}
+
+// T_final bounds and the speed-of-time penalty: cost T_final + rho_sot sum (s - 1)^2. With
+// T_final_min = 2.5 > T* the bound is active (T_final = 2.5, s = 2.5); with rho_sot the optimum
+// stays s = 2 (the penalty's slope 2 rho_sot (s - 1) > 0 only adds to the cost's): objective
+// 2 + rho_sot (one global speed) and 2 + 2 rho_sot (two local ones). Exact scheme: 1e-7.
+TEST(OcpTimeOptimal, FinalTimeBoundsAndSpeedPenalty) {
+  OcpOptions o;
+  o.discretization.N_FE = 2;
+  for (bool local : {false, true}) {
+    Ocp ocp = double_integrator(local);
+    ocp.T_final_min = 2.5;
+    ocp.s_sot0 = 2.5;
+    OcpResult r = solve(ocp, o);
+    ASSERT_EQ(r.status, Status::Success) << r.message;
+    EXPECT_NEAR(r.T_final, 2.5, 1e-7) << "local " << local;
+    EXPECT_NEAR(r.objective, 2.5, 1e-7);
+    EXPECT_NEAR(r.x.back()[0], 1.0, 1e-8);
+    ocp = double_integrator(local);
+    ocp.T_final_max = 1.5;  // below T* = 2: infeasible
+    r = solve(ocp, o);
+    EXPECT_NE(r.status, Status::Success) << "local " << local;
+    ocp = double_integrator(local);
+    ocp.rho_sot = 0.5;
+    r = solve(ocp, o);
+    ASSERT_EQ(r.status, Status::Success) << r.message;
+    EXPECT_NEAR(r.T_final, 2.0, 1e-7) << "local " << local;
+    EXPECT_NEAR(r.objective, 2.0 + (local ? 2 : 1) * 0.5, 1e-7);
+  }
+}
+
+// ---- time freezing -----------------------------------------------------------------------------
+
+/// The states at the end of every control interval (r.x after the interval's last element).
+std::vector<Eigen::VectorXd> interval_ends(const OcpResult& r) {
+  std::vector<Eigen::VectorXd> out;
+  for (std::size_t e = 0; e < r.interval.size(); ++e)
+    if (e + 1 == r.interval.size() || r.interval[e + 1] != r.interval[e]) out.push_back(r.x[e + 1]);
+  return out;
+}
+
+// examples/ocp_time_freezing.toml: an elastic bounce written with time freezing (clock t frozen
+// in the auxiliary region q < 0, v' = a), min int u^2 dt (the state E) to q(1) = v(1) = 1/2 from
+// (q, v) = (1, -5/2). Closed form (the file's header): E* = 4 with u = 2 before the impact at
+// t = 1/2 and u = -2 after; the impact freezes the clock for 2 w / a = 0.2 of s tau (w = 3/2,
+// a = 15). One global speed: s* T / 2 = 1/2 + 0.1, s* = 1.2, the impact from tau = 5/12 to 7/12.
+// Every trajectory is polynomial of degree <= 2: Radau IIA 2 is exact (measured errors ~1e-15).
+TEST(OcpTimeFreezing, ElasticBounceGlobalSpeedOfTime) {
+  const OcpProblem p = example("ocp_time_freezing.toml");
+  EXPECT_TRUE(p.ocp.time_freezing);
+  EXPECT_EQ(p.ocp.clock_state, 2);
+  const OcpResult r = solve(p.ocp, p.options);
+  ASSERT_EQ(r.status, Status::Success) << r.message;
+  EXPECT_NEAR(r.objective, 4.0, 1e-8);
+  EXPECT_NEAR(r.x_final()[3], 4.0, 1e-8);  // E(T) = int u^2 dt
+  EXPECT_NEAR(r.x_final()[0], 0.5, 1e-8);
+  EXPECT_NEAR(r.x_final()[1], 0.5, 1e-8);
+  const std::vector<Eigen::VectorXd> ends = interval_ends(r);
+  ASSERT_EQ(ends.size(), 2u);
+  for (std::size_t k = 0; k < ends.size(); ++k)  // the clock constraints t(tau_k) = k T / N
+    EXPECT_NEAR(ends[k][2], 0.5 * static_cast<double>(k + 1), 1e-8) << k;
+  ASSERT_EQ(r.s_sot.size(), 2u);
+  for (double s : r.s_sot) EXPECT_NEAR(s, 1.2, 1e-8);
+  EXPECT_EQ(r.T_final, 1.0);            // the physical horizon
+  EXPECT_NEAR(r.t.back(), 1.0, 1e-12);  // the grid is the numerical time tau
+  EXPECT_NEAR(r.u[0][0], 2.0, 1e-6);
+  EXPECT_NEAR(r.u[1][0], -2.0, 1e-6);
+  ASSERT_EQ(r.switches.size(), 2u);
+  EXPECT_NEAR(r.switches[0].t, 5.0 / 12, 1e-8);
+  EXPECT_NEAR(r.switches[1].t, 7.0 / 12, 1e-8);
+  double q_min = 1;
+  for (const Eigen::VectorXd& x : r.x) q_min = std::min(q_min, x[0]);
+  EXPECT_NEAR(q_min, -1.5 * 1.5 / (2 * 15), 1e-8);  // -w^2 / (2a): at an element boundary
+}
+
+// The same with rho_sot = 0.1: s is fixed by the clock constraints (u_1, u_2 by the two terminal
+// conditions), so the objective is E* + rho_sot (s* - 1)^2 = 4 + 0.1 * 0.04 = 4.004 (one global
+// speed: one penalty term).
+TEST(OcpTimeFreezing, SpeedOfTimePenalty) {
+  OcpProblem p = example("ocp_time_freezing.toml");
+  p.ocp.rho_sot = 0.1;
+  const OcpResult r = solve(p.ocp, p.options);
+  ASSERT_EQ(r.status, Status::Success) << r.message;
+  EXPECT_NEAR(r.objective, 4.004, 1e-8);
+  EXPECT_NEAR(r.x_final()[3], 4.0, 1e-8);
+}
+
+// Four control intervals with one speed per interval (local_speed_of_time_variable): the optimum
+// u = (2, 2, -2, -2) is piecewise constant on this grid too (the impact at t = 1/2 is a grid
+// point), so E* = 4 is the discrete optimum, now over four controls; the speeds add up to the
+// numerical time: sum_k s_k T / 4 = T + 0.2, sum s_k = 4.8 (how the frozen 0.2 is split between
+// intervals 2 and 3 is not unique). Exact scheme: 1e-8.
+TEST(OcpTimeFreezing, ElasticBounceLocalSpeedsOfTime) {
+  OcpProblem p = example("ocp_time_freezing.toml");
+  p.ocp.N_stages = 4;
+  p.ocp.local_speed_of_time_variable = true;
+  p.ocp.u_guess_stage.clear();
+  p.ocp.u_guess = Eigen::VectorXd::Zero(1);
+  const OcpResult r = solve(p.ocp, p.options);
+  ASSERT_EQ(r.status, Status::Success) << r.message;
+  EXPECT_NEAR(r.objective, 4.0, 1e-8);
+  const std::vector<Eigen::VectorXd> ends = interval_ends(r);
+  ASSERT_EQ(ends.size(), 4u);
+  for (std::size_t k = 0; k < ends.size(); ++k)
+    EXPECT_NEAR(ends[k][2], 0.25 * static_cast<double>(k + 1), 1e-8) << k;
+  ASSERT_EQ(r.s_sot.size(), 4u);
+  double sum = 0;
+  for (double s : r.s_sot) sum += s;
+  EXPECT_NEAR(sum, 4.8, 1e-8);
+  EXPECT_NEAR(r.s_sot[0], 1.0, 1e-8);  // no impact in the first and last interval
+  EXPECT_NEAR(r.s_sot[3], 1.0, 1e-8);
+  for (int k = 0; k < 4; ++k) EXPECT_NEAR(r.u[k][0], k < 2 ? 2.0 : -2.0, 1e-6) << k;
+}
+
+TEST(OcpTimeFreezing, BadInput) {
+  const OcpProblem good = example("ocp_time_freezing.toml");
+  Ocp ocp = good.ocp;
+  ocp.clock_state = -1;  // time freezing without a clock
+  EXPECT_THROW(solve(ocp, good.options), InvalidOption);
+  ocp.clock_state = 4;  // n_x = 4
+  EXPECT_THROW(solve(ocp, good.options), InvalidOption);
+  ocp = good.ocp;
+  ocp.time_freezing_tolerance = -1;
+  EXPECT_THROW(solve(ocp, good.options), InvalidOption);
+  ocp.time_freezing_tolerance = NAN;
+  EXPECT_THROW(solve(ocp, good.options), InvalidOption);
+  ocp = good.ocp;
+  ocp.time_optimal_problem = true;
+  EXPECT_THROW(solve(ocp, good.options), InvalidOption);
+  ocp = good.ocp;
+  ocp.time_freezing = false;  // clock_state without time freezing
+  EXPECT_THROW(solve(ocp, good.options), InvalidOption);
+  ocp = good.ocp;
+  ocp.rho_sot = -1;
+  EXPECT_THROW(solve(ocp, good.options), InvalidOption);
+  ocp = good.ocp;
+  ocp.T_final_max = 3;  // only with time_optimal_problem
+  EXPECT_THROW(solve(ocp, good.options), InvalidOption);
+  ocp = good.ocp;
+  PdsOcp pds;
+  pds.time_freezing = true;
+  pds.clock_state = 0;
+  pds.T = 1;
+  pds.x0 = Eigen::VectorXd::Zero(1);
+  EXPECT_ANY_THROW(solve(pds, OcpOptions{}));
 }
 
 // The JSON result names the new values: T_final, s_sot, v_global (name = value).
