@@ -166,4 +166,17 @@ IntegratorResult integrate(const Pds& model, const Eigen::VectorXd& x0, double T
                            const IntegratorOptions& options = {}, const Eigen::VectorXd& u = {},
                            const Eigen::VectorXd& p = {}, const PdsOptions& pds = {});
 
+/// simulate() (integrator.hpp) of a PDS: the step count chosen by AccuracyOptions (tol_sim, or
+/// N_sim with two companion runs) and the error estimate of the result from step doubling at the
+/// scheme's order, exactly as for piecewise smooth models (docs/problem-files.md, "Accuracy";
+/// docs/pds.md, "Accuracy"). Bad input throws fesd::Error as integrate() does.
+IntegratorResult simulate(const Pds& model, const Eigen::VectorXd& x0, double T_sim,
+                          const AccuracyOptions& accuracy, const IntegratorOptions& options = {},
+                          const Eigen::VectorXd& u = {}, const Eigen::VectorXd& p = {},
+                          const PdsOptions& pds = {});
+
+/// Adds t0 to every time of a result that starts at 0 (t, t_stage, the switches, the switch times
+/// of accuracy.runs): the result of a simulation that starts at t0 (projected files' t0).
+void shift_times(IntegratorResult& result, double t0);
+
 }  // namespace fesd

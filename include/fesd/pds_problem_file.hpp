@@ -2,6 +2,7 @@
 // (docs/pds.md, "Problem files"): [model] kind = "projected" with a vector field `f` and
 // `constraints` (C = {x : constraints >= 0}), read into a fesd::Pds.
 #pragma once
+#include <functional>
 #include <string>
 #include <string_view>
 
@@ -23,7 +24,11 @@ struct PdsSimulationProblem {
   Pds model;
   Eigen::VectorXd x0, u, p;
   double T_sim = 0;
-  int N_sim = 0;  ///< required (> 0): tol_sim is not supported for projected models yet
+  int N_sim = 0;         ///< [simulation] N_sim >= 0; 0: chosen by tol_sim (as SimulationProblem)
+  double tol_sim = 0;    ///< [simulation] tol_sim >= 0 (as SimulationProblem)
+  int N_sim_max = 1000;  ///< [simulation] N_sim_max
+  bool error_estimate = true;  ///< [simulation] error_estimate
+  double t0 = 0;  ///< [simulation] t0: the start time; every time of the result is offset by it
   IntegratorOptions options;
   PdsOptions pds;
 };
@@ -60,15 +65,17 @@ PdsOcpProblem parse_pds_ocp_problem(std::string_view toml_text, std::string_view
 /// Overrides one option of a projected file as if it had been written in the file (`fesd
 /// simulate/solve FILE --key value`): the registry options of its kind ([simulation] or [ocp],
 /// [discretization], [homotopy]), [ipopt] keys, model.x0, model.p ("NAME=VALUE"), simulation.u /
-/// ocp.u_guess. Not yet: tol_sim, t0. Throws fesd::InvalidOption naming the key; on error the
-/// problem is unchanged.
+/// ocp.u_guess, and for simulations t0 (OCPs: no t0). Throws fesd::InvalidOption naming the key; on
+/// error the problem is unchanged.
 void apply_override(PdsSimulationProblem& problem, std::string_view key, std::string_view value);
 void apply_override(PdsOcpProblem& problem, std::string_view key, std::string_view value);
 /// Several overrides, retried in the order fesd::apply_overrides (problem_file.hpp) uses.
 void apply_overrides(PdsSimulationProblem& problem, const OverrideList& overrides);
 void apply_overrides(PdsOcpProblem& problem, const OverrideList& overrides);
 
-/// integrate() of the problem (N_sim steps).
-IntegratorResult simulate(const PdsSimulationProblem& problem);
+/// simulate() of the problem (N_sim steps with an error estimate, or as many as tol_sim needs, as
+/// for SimulationProblem), its times offset by t0; on_run is called after every run.
+IntegratorResult simulate(const PdsSimulationProblem& problem,
+                          const std::function<void(const AccuracyRun&)>& on_run = {});
 
 }  // namespace fesd

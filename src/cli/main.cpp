@@ -617,7 +617,14 @@ void print_header(const fesd::PdsSimulationProblem& problem) {
   print_pds_header(problem, "projected dynamical system",
                    fmt::format("n_c = {}", problem.model.n_c()), problem.model, problem.x0,
                    problem.options.discretization);
-  out::print("  simulation  T_sim = {:g}, N_sim = {}\n", problem.T_sim, problem.N_sim);
+  fesd::AccuracyOptions a;
+  a.tol_sim = problem.tol_sim;
+  a.N_sim = problem.N_sim;
+  a.N_sim_max = problem.N_sim_max;
+  a.error_estimate = problem.error_estimate;
+  out::print("  simulation  T_sim = {:g}{}, {}\n", problem.T_sim,
+             problem.t0 != 0 ? fmt::format(" from t0 = {:g}", problem.t0) : "",
+             fesd::format_accuracy_rule(a, problem.T_sim));
 }
 
 void print_header(const fesd::PdsOcpProblem& problem) {
@@ -654,7 +661,16 @@ int run_simulate_pds(const SolveArgs& args, const CLI::App& cmd) {
     out::print("\n");
     flush_stdout();
   }
-  const fesd::IntegratorResult result = fesd::simulate(problem);
+  std::function<void(const fesd::AccuracyRun&)> on_run;
+  if (!args.quiet) {
+    const double tol = problem.tol_sim > 0  ? problem.tol_sim
+                       : problem.N_sim == 0 ? fesd::kDefaultTolSim
+                                            : 0.0;
+    on_run = [tol](const fesd::AccuracyRun& r) {
+      std::cerr << fesd::format_accuracy_run(r, tol) << std::flush;
+    };
+  }
+  const fesd::IntegratorResult result = fesd::simulate(problem, on_run);
   return finish(result, result.full_report(), problem.model, problem.name, args, cmd, "simulation");
 }
 

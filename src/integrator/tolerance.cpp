@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <initializer_list>
 #include <limits>
 #include <string>
@@ -26,6 +27,7 @@
 #include "core/option_registry.hpp"
 #include "fesd/error.hpp"
 #include "fesd/integrator.hpp"
+#include "fesd/pds.hpp"
 #include "fesd/problem_file.hpp"
 
 namespace fesd {
@@ -208,11 +210,13 @@ int largest_N(double T_sim, int N_sim_max) {
   return n >= N_sim_max ? N_sim_max : std::max(1, static_cast<int>(n));
 }
 
+/// One run of the integrator with N_sim steps (that of a Pss or of a Pds).
+using RunFn = std::function<IntegratorResult(int N_sim, const IntegratorOptions&)>;
+
 class Simulation {
  public:
-  Simulation(const Pss& model, const Eigen::VectorXd& x0, double T_sim, const AccuracyOptions& a,
-             const IntegratorOptions& o, const Eigen::VectorXd& u, const Eigen::VectorXd& p)
-      : model_(model), x0_(x0), T_sim_(T_sim), acc_(a), opt_(o), u_(u), p_(p) {
+  Simulation(RunFn integrate_N, double T_sim, const AccuracyOptions& a, const IntegratorOptions& o)
+      : integrate_(std::move(integrate_N)), T_sim_(T_sim), acc_(a), opt_(o) {
     // Progress of every run through the caller's callback, numbered.
     if (o.on_step) {
       opt_.on_step = [this, cb = o.on_step](const StepProgress& s) {
@@ -328,7 +332,7 @@ class Simulation {
  private:
   Run run(int N) {
     const auto t0 = Clock::now();
-    Run r{integrate(model_, x0_, T_sim_, N, opt_, u_, p_), N};
+    Run r{integrate_(N, opt_), N};
     infos_.push_back(info_of(r, kNaN, std::chrono::duration<double>(Clock::now() - t0).count()));
     return r;
   }
@@ -373,29 +377,54 @@ class Simulation {
     return std::move(r.result);
   }
 
-  const Pss& model_;
-  const Eigen::VectorXd& x0_;
+  RunFn integrate_;
   double T_sim_;
   const AccuracyOptions& acc_;
   IntegratorOptions opt_;
-  const Eigen::VectorXd& u_;
-  const Eigen::VectorXd& p_;
   std::vector<AccuracyRun> infos_;
 };
+
+/// The runs of simulate() for either kind of model.
+IntegratorResult simulate_runs(const RunFn& integrate_N, double T_sim,
+                               const AccuracyOptions& accuracy, const IntegratorOptions& options) {
+  if (const auto e =
+          registry::validate_simulation(T_sim, accuracy.N_sim, accuracy.tol_sim, accuracy.N_sim_max,
+                                        0.0, accuracy.error_estimate);
+      !e.empty())
+    throw InvalidOption(registry::join(e));
+  Simulation s(integrate_N, T_sim, accuracy, options);
+  if (accuracy.N_sim > 0 && accuracy.tol_sim == 0) return s.given();
+  return s.search();
+}
 
 }  // namespace
 
 IntegratorResult simulate(const Pss& model, const Eigen::VectorXd& x0, double T_sim,
                           const AccuracyOptions& accuracy, const IntegratorOptions& options,
                           const Eigen::VectorXd& u, const Eigen::VectorXd& p) {
-  if (const auto e =
-          registry::validate_simulation(T_sim, accuracy.N_sim, accuracy.tol_sim, accuracy.N_sim_max,
-                                        0.0, accuracy.error_estimate);
-      !e.empty())
-    throw InvalidOption(registry::join(e));
-  Simulation s(model, x0, T_sim, accuracy, options, u, p);
-  if (accuracy.N_sim > 0 && accuracy.tol_sim == 0) return s.given();
-  return s.search();
+  return simulate_runs(
+      [&](int N, const IntegratorOptions& o) { return integrate(model, x0, T_sim, N, o, u, p); },
+      T_sim, accuracy, options);
+}
+
+IntegratorResult simulate(const Pds& model, const Eigen::VectorXd& x0, double T_sim,
+                          const AccuracyOptions& accuracy, const IntegratorOptions& options,
+                          const Eigen::VectorXd& u, const Eigen::VectorXd& p,
+                          const PdsOptions& pds) {
+  return simulate_runs(
+      [&](int N, const IntegratorOptions& o) {
+        return integrate(model, x0, T_sim, N, o, u, p, pds);
+      },
+      T_sim, accuracy, options);
+}
+
+void shift_times(IntegratorResult& r, double t0) {
+  if (t0 == 0.0) return;
+  for (double& t : r.t) t += t0;
+  for (double& t : r.t_stage) t += t0;
+  for (SwitchEvent& s : r.switches) s.t += t0;
+  for (AccuracyRun& run : r.accuracy.runs)
+    for (double& t : run.switch_times) t += t0;
 }
 
 IntegratorResult simulate(const SimulationProblem& q,

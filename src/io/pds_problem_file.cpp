@@ -4,6 +4,7 @@
 #include "fesd/pds_problem_file.hpp"
 
 #include <array>
+#include <cmath>
 #include <set>
 #include <string>
 #include <vector>
@@ -34,6 +35,14 @@ constexpr registry::Use kKind = registry::Use::Simulation;
 const toml::table* model_table(const toml::table& root) {
   const toml::node* m = root.get("model");
   return m != nullptr ? m->as_table() : nullptr;
+}
+
+/// The [simulation] keys (as for piecewise smooth files, with the start time t0) and the options.
+std::vector<std::string> validate_all(const PdsSimulationProblem& q) {
+  std::vector<std::string> e = registry::validate_simulation(q.T_sim, q.N_sim, q.tol_sim,
+                                                             q.N_sim_max, q.t0, q.error_estimate);
+  for (std::string& s : validate(q.options)) e.push_back(std::move(s));
+  return e;
 }
 
 }  // namespace
@@ -195,11 +204,7 @@ PdsSimulationProblem parse_pds_simulation_problem(std::string_view toml_text,
     if (table == registry::Table::Simulation) {
       if (const toml::node* un = t.get("u"))
         problem.u = r.vector(*un, "simulation.u", n_u, "one per control in model.u");
-      if (const toml::node* tol = t.get("tol_sim"))
-        r.fail(tol->source(), "simulation.tol_sim",
-               "not supported for projected models yet (give N_sim)");
-      if (const toml::node* t0 = t.get("t0"))
-        r.fail(t0->source(), "simulation.t0", "not supported for projected models yet");
+      if (const toml::node* t0 = t.get("t0")) problem.t0 = r.number(*t0, "simulation.t0");
     }
     check_table_keys(r, t, table, kKind);
     read_option_table(r, t, table, kKind, target, options_only.options.nlp.extra);
@@ -208,12 +213,11 @@ PdsSimulationProblem parse_pds_simulation_problem(std::string_view toml_text,
   problem.options = options_only.options;
   problem.T_sim = options_only.T_sim;
   problem.N_sim = options_only.N_sim;
-  std::vector<std::string> errors = registry::validate_simulation(problem.T_sim, problem.N_sim);
-  for (std::string& e : validate(problem.options)) errors.push_back(std::move(e));
+  problem.tol_sim = options_only.tol_sim;
+  problem.N_sim_max = options_only.N_sim_max;
+  problem.error_estimate = options_only.error_estimate;
+  const std::vector<std::string> errors = validate_all(problem);
   if (!errors.empty()) throw_validation_errors(r, root, errors);
-  if (problem.N_sim < 1)
-    r.fail(root.source(), "simulation.N_sim",
-           "required for projected models (>= 1; tol_sim is not supported for them yet)");
   return problem;
 }
 
@@ -221,8 +225,17 @@ PdsSimulationProblem load_pds_simulation_problem(const std::string& path) {
   return parse_pds_simulation_problem(read_problem_text(path), path);
 }
 
-IntegratorResult simulate(const PdsSimulationProblem& q) {
-  return integrate(q.model, q.x0, q.T_sim, q.N_sim, q.options, q.u, q.p, q.pds);
+IntegratorResult simulate(const PdsSimulationProblem& q,
+                          const std::function<void(const AccuracyRun&)>& on_run) {
+  AccuracyOptions a;
+  a.tol_sim = q.tol_sim;
+  a.N_sim = q.N_sim;
+  a.N_sim_max = q.N_sim_max;
+  a.error_estimate = q.error_estimate;
+  a.on_run = on_run;
+  IntegratorResult r = simulate(q.model, q.x0, q.T_sim, a, q.options, q.u, q.p, q.pds);
+  shift_times(r, q.t0);
+  return r;
 }
 
 namespace io_detail {
@@ -240,8 +253,6 @@ bool set_pds_override(const OverrideArg& a, Pds& model,
     *u = override_vector(a.head, a.value, n_u, "simulation.u", "one per control");
   } else if (set_parameter_override(a, model.parameter_names, p, model.p_default)) {
     // one parameter of model.p
-  } else if (key == "tol_sim" || key == "t0") {
-    throw InvalidOption(fmt::format("{}: not supported for projected models yet", a.head));
   } else {
     return false;
   }
@@ -257,18 +268,29 @@ void apply_override(PdsSimulationProblem& problem, std::string_view key, std::st
   s.options = problem.options;
   s.T_sim = problem.T_sim;
   s.N_sim = problem.N_sim;
+  s.tol_sim = problem.tol_sim;
+  s.N_sim_max = problem.N_sim_max;
+  s.error_estimate = problem.error_estimate;
   PdsSimulationProblem updated = problem;
-  if (!set_scalar_override(arg, target_of(s)) &&
-      !set_pds_override(arg, updated.model, s.options.nlp.extra, updated.x0, updated.p, &updated.u))
+  const std::string_view input = arg.option != nullptr ? arg.option->key : std::string_view{};
+  if (set_scalar_override(arg, target_of(s))) {
+    // a registry option with a C++ member
+  } else if (input == "t0") {
+    const auto d = parse_double(arg.value);
+    if (!d) override_error(arg.head, "expected a number");
+    if (!std::isfinite(*d)) override_error(arg.head, "must be finite");
+    updated.t0 = *d;
+  } else if (!set_pds_override(arg, updated.model, s.options.nlp.extra, updated.x0, updated.p,
+                               &updated.u)) {
     unknown_override(arg, kKind, Pss{});
-  if (s.tol_sim > 0)
-    override_error(arg.head, "not supported for projected models yet (give N_sim)");
+  }
   updated.options = s.options;
   updated.T_sim = s.T_sim;
   updated.N_sim = s.N_sim;
-  std::vector<std::string> errors = registry::validate_simulation(updated.T_sim, updated.N_sim);
-  for (std::string& e : validate(updated.options)) errors.push_back(std::move(e));
-  if (updated.N_sim < 1) errors.push_back("simulation.N_sim: must be >= 1 for projected models");
+  updated.tol_sim = s.tol_sim;
+  updated.N_sim_max = s.N_sim_max;
+  updated.error_estimate = s.error_estimate;
+  const std::vector<std::string> errors = validate_all(updated);
   if (!errors.empty()) throw_override_errors(arg, errors);
   problem = std::move(updated);
 }

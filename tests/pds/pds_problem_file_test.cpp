@@ -72,6 +72,68 @@ TEST(PdsProblemFile, Example1) {
   EXPECT_NEAR(r.switches[1].t, pds_example1::kLeave, 8e-7);
 }
 
+// [simulation] t0 (issue 16): the run starts at t0, every time of the result is offset by it
+// (element boundaries, stage points, switches, the runs of the estimate) and x(T) is the same.
+// Example 1 from t0 = 5: contact at 5 + 5 pi/12, leaving at 5 + 5 pi/12 + sqrt 3, x(T) = (-1, 0).
+TEST(PdsProblemFile, StartTimeOffsetsEveryTime) {
+  const std::string text = replace(kExample1, "N_sim = 1\n", "N_sim = 1\nt0 = 5\n");
+  const fesd::PdsSimulationProblem q = fesd::parse_pds_simulation_problem(text, "f.toml");
+  EXPECT_EQ(q.t0, 5.0);
+  const fesd::IntegratorResult r = fesd::simulate(q);
+  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+  EXPECT_LT((r.x_final() - pds_example1::x_T()).norm(), 6e-7);
+  EXPECT_EQ(r.t.front(), 5.0);
+  EXPECT_NEAR(r.t.back(), 5.0 + pds_example1::kT, 1e-12);
+  EXPECT_GE(r.t_stage.front(), 5.0);
+  ASSERT_EQ(r.switches.size(), 2u);
+  EXPECT_NEAR(r.switches[0].t, 5.0 + pds_example1::kContact, 8e-7);
+  EXPECT_NEAR(r.switches[1].t, 5.0 + pds_example1::kLeave, 8e-7);
+  ASSERT_FALSE(r.accuracy.runs.empty());
+  for (const fesd::AccuracyRun& run : r.accuracy.runs) {
+    ASSERT_EQ(run.switch_times.size(), 2u);
+    EXPECT_NEAR(run.switch_times[0], 5.0 + pds_example1::kContact, 1e-5);
+  }
+
+  // The same run from t0 = 0 gives the same x(T) and the times 5 earlier.
+  const fesd::IntegratorResult r0 =
+      fesd::simulate(fesd::parse_pds_simulation_problem(kExample1, "f.toml"));
+  ASSERT_EQ(r0.status, fesd::Status::Success) << r0.message;
+  EXPECT_LT((r.x_final() - r0.x_final()).norm(), 1e-12);
+  ASSERT_EQ(r.t.size(), r0.t.size());
+  for (std::size_t n = 0; n < r.t.size(); ++n) EXPECT_NEAR(r.t[n], r0.t[n] + 5.0, 1e-12);
+
+  // --t0 overrides it.
+  fesd::PdsSimulationProblem o = q;
+  fesd::apply_override(o, "t0", "-2.5");
+  EXPECT_EQ(o.t0, -2.5);
+  EXPECT_THROW(fesd::apply_override(o, "t0", "inf"), fesd::InvalidOption);
+  EXPECT_EQ(o.t0, -2.5);
+}
+
+// [simulation] tol_sim (issue 16): N_sim chosen by step doubling as for piecewise smooth files.
+// Example 1 with Radau IIA n_s = 2 (order 3), N_FE = 10, from N_sim = 1: measured runs N_sim =
+// 1, 2, 8, 19, estimate 5.3e-7, true error 5.4e-7. Asserted: the error <= tol_sim = 1e-6 and the
+// estimate within a factor 3 of it.
+TEST(PdsProblemFile, TolSimMeetsTheExactSolution) {
+  std::string text = replace(kExample1, "N_sim = 1\n", "N_sim = 1\ntol_sim = 1e-6\n");
+  text = replace(text, "n_s = 3\nN_finite_elements = 20", "n_s = 2\nN_finite_elements = 10");
+  const fesd::PdsSimulationProblem q = fesd::parse_pds_simulation_problem(text, "f.toml");
+  EXPECT_EQ(q.tol_sim, 1e-6);
+  const fesd::IntegratorResult r = fesd::simulate(q);
+  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+  const double error = (r.x_final() - pds_example1::x_T()).norm();
+  EXPECT_LE(error, 1e-6);
+  EXPECT_TRUE(r.accuracy.met);
+  EXPECT_EQ(r.accuracy.order, 3);
+  EXPECT_LE(r.accuracy.error_estimate, 1e-6);
+  EXPECT_GE(r.accuracy.error_estimate, error / 3) << error;
+  EXPECT_LE(r.accuracy.error_estimate, 3 * error) << error;
+  EXPECT_GE(r.accuracy.runs.size(), 3u);
+  EXPECT_GT(r.accuracy.N_sim, 2);
+  ASSERT_EQ(r.switches.size(), 2u);
+  EXPECT_NEAR(r.switches[1].t, pds_example1::kLeave, 1e-5);
+}
+
 TEST(PdsProblemFile, MixingTheKindsRejected) {
   const std::string m = error_of<fesd::ProblemFileError>(
       replace(kExample1, "constraints = [\"x2 + a\"]", "constraints = [\"x2 + a\"]\nc = [\"x1\"]"));
@@ -88,8 +150,14 @@ TEST(PdsProblemFile, BadInputOneLineEach) {
       error_of<fesd::ProblemFileError>(replace(kExample1, "f = [\"x2\", \"-x1\"]", "f = [\"x2\"]"))
           .find("model.f: wrong length"),
       std::string::npos);
-  EXPECT_NE(error_of<fesd::Error>(replace(kExample1, "N_sim = 1\n", "")).find("N_sim"),
+  EXPECT_NE(error_of<fesd::Error>(replace(kExample1, "N_sim = 1\n", "N_sim = -1\n")).find("N_sim"),
             std::string::npos);
+  EXPECT_NE(error_of<fesd::Error>(replace(kExample1, "N_sim = 1\n", "N_sim = 1\ntol_sim = -1\n"))
+                .find("tol_sim"),
+            std::string::npos);
+  EXPECT_NE(
+      error_of<fesd::Error>(replace(kExample1, "N_sim = 1\n", "N_sim = 1\nt0 = nan\n")).find("t0"),
+      std::string::npos);
   EXPECT_NE(error_of<fesd::ProblemFileError>(
                 replace(kExample1, "x0 = [1.4142135623730951, ", "x0 = [nan, "))
                 .find("must be finite"),
@@ -217,8 +285,9 @@ TEST(PdsCli, Overrides) {
   ASSERT_EQ(ok.code, 0) << ok.err;
   EXPECT_NE(ok.out.find("n_s = 2, N_FE = 10"), std::string::npos) << ok.out;
   for (const std::string& extra :
-       {std::string("--n_S 2"), std::string("--p a=2"), std::string("--tol_sim 1e-3"),
-        std::string("--x0 1,2,3"), std::string("--N_sim 0")}) {
+       {std::string("--n_S 2"), std::string("--p a=2"), std::string("--tol_sim -1"),
+        std::string("--x0 1,2,3"), std::string("--N_sim -1"), std::string("--t0 nan"),
+        std::string("--t0 x")}) {
     const CliRun r = fesd_cli(file + " " + extra);
     EXPECT_EQ(r.code, 2) << extra << r.out;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << extra << ": " << r.err;
@@ -246,7 +315,7 @@ TEST(PdsCli, CheckDescribesTheModel) {
   for (const char* part : {"optimal control of a projected dynamical system", "controls    u1, v1",
                            "c[1]        (x3 - x2)^2", "costs and constraints as read", "f_q_T"})
     EXPECT_NE(ocp.out.find(part), std::string::npos) << part << "\n" << ocp.out;
-  for (const std::string& bad : {std::string("--p b=2"), std::string("--tol_sim 1e-3")}) {
+  for (const std::string& bad : {std::string("--p b=2"), std::string("--tol_sim -1")}) {
     const CliRun e = fesd_cli("'" + file + "' " + bad, "check");
     EXPECT_EQ(e.code, 2) << bad;
     EXPECT_EQ(std::count(e.err.begin(), e.err.end(), '\n'), 1) << bad << ": " << e.err;

@@ -45,8 +45,8 @@ def test_example1_from_a_dict():
 
 
 def test_projected_input_errors(examples):
-    with pytest.raises(fesd.InputError, match="not supported for projected models"):
-        fesd.simulate(examples / "pds_example1.toml", tol_sim=1e-6)
+    with pytest.raises(fesd.InputError, match="tol_sim"):
+        fesd.simulate(examples / "pds_example1.toml", tol_sim=-1)
     with pytest.raises(fesd.InputError, match="x0 lies outside C"):  # x0 below x2 = -1
         fesd.simulate({"model": {"kind": "projected", "x": ["x1", "x2"], "f": ["x2", "-x1"],
                              "constraints": ["x2 + 1"], "x0": [0, -2]},
@@ -71,3 +71,13 @@ def test_projected_overrides(examples):
     r = fesd.simulate(examples / "pds_example1.toml", n_s=2)
     assert r.success, r.message
     assert 1e-5 < np.linalg.norm(r.x[-1] - [-1, 0]) < 1e-3
+
+
+def test_projected_tol_sim_and_t0(examples):
+    # tol_sim as for piecewise smooth files (runs N_sim = 1, 2, 4 measured, error 2.4e-10);
+    # t0 = 5 offsets every time and leaves x(T) as it is.
+    r = fesd.simulate(examples / "pds_example1.toml", tol_sim=1e-6, t0=5)
+    assert r.success, r.message
+    assert np.linalg.norm(r.x[-1] - [-1, 0]) <= 1e-6
+    assert r.t[0] == 5
+    assert r.switch_times == pytest.approx([5 + T_CONTACT, 5 + T_LEAVE], abs=1e-5)
