@@ -652,6 +652,17 @@ int run_check_pds(const std::string& file, const Overrides& overrides) {
 
 /// `fesd simulate` of a projected dynamical system ([model] kind = "projected", docs/pds.md): the
 /// header, integrate() and the report; --json and --csv as for piecewise smooth models.
+/// One progress line per simulation run on stderr (N_sim chosen by tol_sim, or the companions of
+/// the error estimate); none with --quiet.
+std::function<void(const fesd::AccuracyRun&)> progress_lines(const SolveArgs& args, double tol_sim,
+                                                             int N_sim) {
+  if (args.quiet) return {};
+  const double tol = tol_sim > 0 ? tol_sim : N_sim == 0 ? fesd::kDefaultTolSim : 0.0;
+  return [tol](const fesd::AccuracyRun& r) {
+    std::cerr << fesd::format_accuracy_run(r, tol) << std::flush;
+  };
+}
+
 int run_simulate_pds(const SolveArgs& args, const CLI::App& cmd) {
   check_outputs(args, cmd);
   fesd::PdsSimulationProblem problem = fesd::load_pds_simulation_problem(args.file);
@@ -661,15 +672,7 @@ int run_simulate_pds(const SolveArgs& args, const CLI::App& cmd) {
     out::print("\n");
     flush_stdout();
   }
-  std::function<void(const fesd::AccuracyRun&)> on_run;
-  if (!args.quiet) {
-    const double tol = problem.tol_sim > 0  ? problem.tol_sim
-                       : problem.N_sim == 0 ? fesd::kDefaultTolSim
-                                            : 0.0;
-    on_run = [tol](const fesd::AccuracyRun& r) {
-      std::cerr << fesd::format_accuracy_run(r, tol) << std::flush;
-    };
-  }
+  const auto on_run = progress_lines(args, problem.tol_sim, problem.N_sim);
   const fesd::IntegratorResult result = fesd::simulate(problem, on_run);
   return finish(result, result.full_report(), problem.model, problem.name, args, cmd, "simulation");
 }
@@ -678,16 +681,7 @@ int run_simulate(const SolveArgs& args, const CLI::App& cmd) {
   check_input_file(args.file);
   if (fesd::is_projected_problem_file(args.file)) return run_simulate_pds(args, cmd);
   const auto problem = prepare<fesd::SimulationProblem>(args, cmd);
-  // One progress line per run (N_sim chosen by tol_sim, or the companions of the estimate).
-  std::function<void(const fesd::AccuracyRun&)> on_run;
-  if (!args.quiet) {
-    const double tol = problem.tol_sim > 0  ? problem.tol_sim
-                       : problem.N_sim == 0 ? fesd::kDefaultTolSim
-                                            : 0.0;
-    on_run = [tol](const fesd::AccuracyRun& r) {
-      std::cerr << fesd::format_accuracy_run(r, tol) << std::flush;
-    };
-  }
+  const auto on_run = progress_lines(args, problem.tol_sim, problem.N_sim);
   const fesd::IntegratorResult result = fesd::simulate(problem, on_run);
   return finish(result, result.full_report(), problem.model, problem.name, args, cmd, "simulation");
 }
