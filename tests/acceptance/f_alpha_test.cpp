@@ -12,6 +12,7 @@
 #include <Eigen/Dense>
 
 #include "fesd/integrator.hpp"
+#include "fesd/ocp.hpp"
 #include "fesd/problem_file.hpp"
 
 namespace {
@@ -106,6 +107,24 @@ TEST(FAlpha, NonlinearCodimTwoClosedForm) {
   ASSERT_FALSE(b.alpha.empty());
   EXPECT_NEAR(b.alpha.back()[0], 1.0 / std::sqrt(2.0), 1e-6);
   EXPECT_NEAR(b.alpha.back()[1], 0.5, 1e-6);
+}
+
+}  // namespace
+
+namespace {
+
+// OCP (56) with f_alpha (examples/ocp_sensitivity_f_alpha.toml) against the region form in the
+// step form and the exact optimum V* = 1.5237727753749571, x0* = (9 - sqrt(417)) / 8.
+TEST(FAlpha, SensitivityOcpSameObjective) {
+  fesd::OcpProblem r = fesd::load_ocp_problem(example("ocp_sensitivity.toml"));
+  fesd::apply_override(r, "dcs_mode", "step");
+  const fesd::OcpProblem f = fesd::load_ocp_problem(example("ocp_sensitivity_f_alpha.toml"));
+  const fesd::OcpResult a = fesd::solve(r.ocp, r.options), b = fesd::solve(f.ocp, f.options);
+  ASSERT_EQ(a.status, fesd::Status::Success) << a.message;
+  ASSERT_EQ(b.status, fesd::Status::Success) << b.message;
+  EXPECT_NEAR(b.objective, a.objective, 1e-9);
+  EXPECT_NEAR(b.objective, 1.5237727753749571, 1e-6);
+  EXPECT_NEAR(b.x0()[0], (9.0 - std::sqrt(417.0)) / 8.0, 1e-5);
 }
 
 }  // namespace
