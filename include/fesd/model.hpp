@@ -81,6 +81,17 @@ class PssFunctions {
   }
   virtual void algebraic(const double* /*x*/, const double* /*u*/, const double* /*p*/,
                          double* /*z*/) const {}
+  /// A general inclusion in the Heaviside step form (problem files' f_alpha): x' = f_alpha(x,
+  /// alpha, u, p), one alpha per switching function (all subsystems' c, concatenated). Only in
+  /// discretization.dcs_mode = step; f(r, ...) is then f_alpha at region r's 0/1 alpha vertex.
+  virtual bool has_f_alpha() const {
+    return false;
+  }
+#define FESD_DECLARE_F_ALPHA(T)                                                            \
+  virtual void f_alpha(const T* /*x*/, const T* /*alpha*/, const T* /*u*/, const T* /*p*/, \
+                       T* /*f_out*/) const {}
+  FESD_FOR_EACH_SCALAR(FESD_DECLARE_F_ALPHA)
+#undef FESD_DECLARE_F_ALPHA
 };
 
 /// A piecewise smooth system in Stewart form. Cheap to copy (shares its functions).
@@ -101,6 +112,8 @@ class Pss {
   int n_g() const { return n_g_; }  // direct indicator functions over all subsystems
   /// Algebraic variables z (PssFunctions::n_z; results report z at the stage points).
   int n_z() const { return functions_ ? functions_->n_z() : 0; }
+  /// Whether the dynamics are a general inclusion f_alpha(x, alpha, u, p) (PssFunctions).
+  bool has_f_alpha() const { return functions_ && functions_->has_f_alpha(); }
   /// First region index of subsystem k; regions of k are [region_offset(k), region_offset(k+1)).
   int region_offset(int k) const { return region_offset_[k]; }
   /// The sign matrix of subsystem k (filled in if it was given empty). Empty for g-form.
@@ -129,18 +142,28 @@ template <class Model>
 class PssFunctionsFor final : public PssFunctions {
  public:
   explicit PssFunctionsFor(Model m) : m_(std::move(m)) {}
-#define FESD_IMPLEMENT_PSS_FUNCTIONS(T)                                             \
-  void c(const T* x, const T* p, T* c_out) const override {                         \
-    if constexpr (requires { m_.c(x, p, c_out); }) m_.c(x, p, c_out);               \
-  }                                                                                 \
-  void g(const T* x, const T* p, T* g_out) const override {                         \
-    if constexpr (requires { m_.g(x, p, g_out); }) m_.g(x, p, g_out);               \
-  }                                                                                 \
-  void f(int region, const T* x, const T* u, const T* p, T* f_out) const override { \
-    m_.f(region, x, u, p, f_out);                                                   \
+#define FESD_IMPLEMENT_PSS_FUNCTIONS(T)                                                       \
+  void c(const T* x, const T* p, T* c_out) const override {                                   \
+    if constexpr (requires { m_.c(x, p, c_out); }) m_.c(x, p, c_out);                         \
+  }                                                                                           \
+  void g(const T* x, const T* p, T* g_out) const override {                                   \
+    if constexpr (requires { m_.g(x, p, g_out); }) m_.g(x, p, g_out);                         \
+  }                                                                                           \
+  void f(int region, const T* x, const T* u, const T* p, T* f_out) const override {           \
+    m_.f(region, x, u, p, f_out);                                                             \
+  }                                                                                           \
+  void f_alpha(const T* x, const T* alpha, const T* u, const T* p, T* f_out) const override { \
+    if constexpr (requires { m_.f_alpha(x, alpha, u, p, f_out); })                            \
+      m_.f_alpha(x, alpha, u, p, f_out);                                                      \
   }
   FESD_FOR_EACH_SCALAR(FESD_IMPLEMENT_PSS_FUNCTIONS)
 #undef FESD_IMPLEMENT_PSS_FUNCTIONS
+  bool has_f_alpha() const override {
+    return requires(const Model& m, const double* v, double* o) {
+      m.f_alpha(v, v, v, v, o);
+    };
+  }
+
  private:
   Model m_;
 };

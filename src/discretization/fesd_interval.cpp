@@ -112,6 +112,25 @@ struct StepThetaEq {
   }
 };
 
+/// The step form's dynamics of a general inclusion (PssFunctions::f_alpha): V - f_alpha(X, alpha,
+/// q, p) = 0.  inputs: V (n_x), X (n_x), alpha (n_c), q (n_u), p (n_p)
+struct AlphaDynamicsEq {
+  const Pss* m;
+  int num_inputs() const { return 2 * m->n_x() + m->n_c() + m->n_u() + m->n_p(); }
+  int num_outputs() const { return m->n_x(); }
+  template <class T>
+  void operator()(const T* w, T* c) const {
+    const int n_x = m->n_x();
+    const T* V = w;
+    const T* X = w + n_x;
+    const T* alpha = X + n_x;
+    const T* q = alpha + m->n_c();
+    const T* p = q + m->n_u();
+    m->functions().f_alpha(X, alpha, q, p, c);
+    for (int i = 0; i < n_x; ++i) c[i] = V[i] - c[i];
+  }
+};
+
 /// alpha_j + beta_j = 1 (beta = 1 - alpha as a variable).  inputs: alpha (n_c), beta (n_c)
 struct AlphaBetaEq {
   int n_c;
@@ -168,6 +187,10 @@ std::vector<std::string> FesdInterval::block_size_errors(const Pss& m,
   std::vector<std::string> errors;
   if (options.dcs_mode == DcsMode::Step)
     if (std::string e = dcs::step_mode_error(m); !e.empty()) return {e};
+  if (m.has_f_alpha() && options.dcs_mode != DcsMode::Step)
+    return {
+        "model.f_alpha needs discretization.dcs_mode = \"step\" (the general inclusion f(x, "
+        "alpha) is written in the Heaviside step form; Stewart's form needs region-wise F)"};
   const int limit = ad::kMaxInputs;
   const int n_x = m.n_x(), n_th = m.n_theta();
   // The model's blocks, as build() creates them (the same functors, so the counts cannot drift).
@@ -277,7 +300,10 @@ void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
   const auto owner = dcs::region_subsystem(m);
   std::vector<int> offsets;
   for (int k = 0; k <= n_sys; ++k) offsets.push_back(m.region_offset(k));
-  const std::shared_ptr<const nlp::Block> dynamics = std::make_shared<DynamicsBlock>(m);
+  const bool by_alpha = step_ && m.has_f_alpha();  // V = f_alpha(X, alpha) instead of (25)
+  const std::shared_ptr<const nlp::Block> dynamics =
+      by_alpha ? make_block(AlphaDynamicsEq{&m})
+               : std::shared_ptr<const nlp::Block>(std::make_shared<DynamicsBlock>(m));
   // The multiplier equation of a point: Stewart's LP (9), or the step form's c = lambda_p -
   // lambda_n; inputs X, lambda (n_lam), mu (n_mu), p either way.
   auto lp = step_ ? make_block(StepCEq{&m}) : make_block(LpEq{&m, owner});
@@ -314,7 +340,10 @@ void FesdInterval::build(nlp::BlockNlp& nlp, const IntervalInputs& in) {
       }
       std::vector<int> dv = range(V(n, s, 0), n_x);  // (25): V = F(X) theta
       for (int i = 0; i < n_x; ++i) dv.push_back(X(n, s, i));
-      for (int r = 0; r < n_th; ++r) dv.push_back(theta(n, s, r));
+      if (by_alpha)
+        for (int j = 0; j < n_c; ++j) dv.push_back(alpha(n, s, j));
+      else
+        for (int r = 0; r < n_th; ++r) dv.push_back(theta(n, s, r));
       dv.insert(dv.end(), in.q.begin(), in.q.end());
       dv.insert(dv.end(), in.p.begin(), in.p.end());
       nlp.add_constraint(dynamics, dv, 0.0, 0.0);

@@ -17,8 +17,8 @@ namespace {
 constexpr std::array<std::string_view, 13> kReservedNames{
     "sin", "cos", "tan", "exp", "log", "sqrt", "tanh", "abs", "sinh", "cosh", "atan", "pow", "pi"};
 
-constexpr std::array<std::string_view, 12> kModelKeys{"x", "u",  "p",         "c", "S",  "F",
-                                                      "g", "x0", "subsystem", "z", "z0", "g_z"};
+constexpr std::array<std::string_view, 13> kModelKeys{
+    "x", "u", "p", "c", "S", "F", "g", "x0", "subsystem", "z", "z0", "g_z", "f_alpha"};
 constexpr std::array<std::string_view, 4> kSubsystemKeys{"c", "S", "g", "F"};
 
 std::string lower(std::string_view s) {
@@ -107,7 +107,7 @@ Eigen::MatrixXd read_sign_matrix(const Reader& r, const toml::node& n, std::stri
 }
 
 RawSubsystem read_subsystem(const Reader& r, const toml::table& t, std::string_view path,
-                            const Symbols& sym) {
+                            const Symbols& sym, bool by_alpha = false) {
   RawSubsystem out;
   const toml::node* c = t.get("c");
   const toml::node* S = t.get("S");
@@ -124,7 +124,16 @@ RawSubsystem read_subsystem(const Reader& r, const toml::table& t, std::string_v
   if (S != nullptr && c == nullptr)
     r.fail(S->source(), join(path, "S"),
            "a sign matrix needs switching functions c (with indicator functions g, give no S)");
-  if (F == nullptr)
+  if (by_alpha) {  // the general inclusion f_alpha (read by read_model_spec) instead of F
+    if (F != nullptr)
+      r.fail(F->source(), join(path, "F"),
+             "given both f_alpha and region-wise F (expected one of them: f_alpha(x, alpha, u, p) "
+             "in the Heaviside step form, or one vector field per region)");
+    if (c == nullptr)
+      r.fail(g->source(), join(path, "g"),
+             "f_alpha needs switching functions c (alpha_j belongs to c_j), not indicator "
+             "functions g");
+  } else if (F == nullptr)
     r.fail(t.source(), path,
            "missing key 'F' (expected one vector field per region, each an array of n_x "
            "expressions)");
@@ -162,6 +171,7 @@ RawSubsystem read_subsystem(const Reader& r, const toml::table& t, std::string_v
     out.n_f = static_cast<int>(a.size());
   }
 
+  if (by_alpha) return out;
   const std::string fp = join(path, "F");
   const toml::array& fields = r.array(*F, fp, "an array of vector fields, one per region");
   const std::string region_source =
@@ -187,12 +197,38 @@ RawSubsystem read_subsystem(const Reader& r, const toml::table& t, std::string_v
   return out;
 }
 
+/// model.f_alpha: n_x expressions of x, t, u, p, z and alpha_1 .. alpha_{n_c} (the Heaviside step
+/// form's general inclusion; docs/problem-files.md).
+void read_f_alpha(const Reader& r, const toml::node& n, const Symbols& sym, RawSubsystem& s) {
+  const std::string path = "model.f_alpha";
+  const std::size_t n_c = s.expressions.c.size();
+  std::vector<std::string> symbols = sym.all;
+  for (std::size_t j = 1; j <= n_c; ++j) {
+    const std::string a = fmt::format("alpha_{}", j);
+    if (std::find(sym.all.begin(), sym.all.end(), a) != sym.all.end())
+      r.fail(
+          n.source(), path,
+          fmt::format("the name '{}' is taken (f_alpha reads alpha_j, j = 1 .. n_c = {}, for the "
+                      "switching functions c; rename the state, control, parameter or "
+                      "algebraic variable)",
+                      a, n_c));
+    symbols.push_back(a);
+  }
+  const toml::array& a = r.array(n, path, "an array of n_x expressions");
+  if (a.size() != sym.x.size())
+    r.fail(n.source(), path,
+           fmt::format("wrong length (expected {} expressions, one per state, got {})",
+                       sym.x.size(), a.size()));
+  for (std::size_t i = 0; i < a.size(); ++i)
+    s.expressions.f_alpha.push_back(r.expression(a[i], index(path, i), symbols));
+}
+
 bool uses_symbol(const RawSubsystem& s, int index) {
   const auto any = [&](const std::vector<expr::Expression>& list) {
     return std::any_of(list.begin(), list.end(),
                        [&](const expr::Expression& e) { return e.depends_on(index); });
   };
-  if (any(s.expressions.c) || any(s.expressions.g)) return true;
+  if (any(s.expressions.c) || any(s.expressions.g) || any(s.expressions.f_alpha)) return true;
   return std::any_of(s.expressions.F.begin(), s.expressions.F.end(), any);
 }
 
@@ -496,6 +532,10 @@ ModelSpec read_model_spec(const Reader& r, const toml::table& root) {
 
   // Regions and vector fields: directly in [model] or in [[model.subsystem]].
   if (const toml::node* sub = model.get("subsystem")) {
+    if (const toml::node* fa = model.get("f_alpha"))
+      r.fail(fa->source(), "model.f_alpha",
+             "needs the switching functions c directly in [model] (one subsystem; alpha_j belongs "
+             "to c_j), not [[model.subsystem]]");
     for (std::string_view k : kSubsystemKeys)
       if (const toml::node* direct = model.get(k))
         r.fail(direct->source(), join("model", k),
@@ -513,7 +553,9 @@ ModelSpec read_model_spec(const Reader& r, const toml::table& root) {
       spec.subsystems.push_back(read_subsystem(r, t, path, sym));
     }
   } else {
-    spec.subsystems.push_back(read_subsystem(r, model, "model", sym));
+    const toml::node* fa = model.get("f_alpha");
+    spec.subsystems.push_back(read_subsystem(r, model, "model", sym, fa != nullptr));
+    if (fa != nullptr) read_f_alpha(r, *fa, sym, spec.subsystems.back());
   }
   return spec;
 }
@@ -529,7 +571,12 @@ BuiltModel build_model(const Reader& r, ModelSpec spec, bool has_clock, double t
     const expr::Expression zero = expr::Expression::parse("0", sym.all, "clock t' = 0");
     for (std::size_t k = 0; k < subsystems.size(); ++k)
       for (auto& field : subsystems[k].expressions.F) field.push_back(k == 0 ? one : zero);
+    if (!subsystems[0].expressions.f_alpha.empty())
+      subsystems[0].expressions.f_alpha.push_back(one);
   }
+  const int n_alpha = subsystems[0].expressions.f_alpha.empty()
+                          ? 0
+                          : static_cast<int>(subsystems[0].expressions.c.size());
 
   // x0.
   const toml::node* x0_node = model.get("x0");
@@ -562,6 +609,7 @@ BuiltModel build_model(const Reader& r, ModelSpec spec, bool has_clock, double t
   layout.n_x_slots = n_x_user + (sym.time_index >= 0 ? 1 : 0);
   layout.n_u = dims.n_u;
   layout.n_p = dims.n_p;
+  layout.n_alpha = n_alpha;
   if (!sym.z.empty())
     layout.algebraic = std::make_shared<const AlgebraicEquations>(
         layout.n_x_slots + layout.n_u + layout.n_p, std::move(spec.g_z), spec.z0);

@@ -98,7 +98,16 @@ ExpressionModel::ExpressionModel(ExpressionLayout layout,
     const std::string where = fmt::format("internal: expression model: subsystem {}", k);
     if (s.c.empty() == s.g.empty())
       throw InternalError(where + ": give either switching functions c or indicator functions g");
-    if (s.F.empty()) throw InternalError(where + ": no vector fields F");
+    if (!s.f_alpha.empty()) {
+      if (subsystems.size() != 1 || s.c.empty() || !s.F.empty())
+        throw InternalError(where + ": f_alpha needs one c-form subsystem and no F");
+      if (static_cast<int>(s.f_alpha.size()) != L.n_x || L.n_alpha != static_cast<int>(s.c.size()))
+        throw InternalError(fmt::format("{}: f_alpha has {} components (n_x = {}), n_alpha = {}",
+                                        where, s.f_alpha.size(), L.n_x, L.n_alpha));
+      for (const expr::Expression& e : s.f_alpha) check_symbols(e, where + " f_alpha");
+    } else if (s.F.empty()) {
+      throw InternalError(where + ": no vector fields F");
+    }
     for (const auto& list : {std::cref(s.c), std::cref(s.g)}) {
       for (const expr::Expression& e : list.get()) {
         check_symbols(e, where + " c/g");
@@ -118,12 +127,24 @@ ExpressionModel::ExpressionModel(ExpressionLayout layout,
     for (expr::Expression& e : s.c) c_.push_back(std::move(e));
     for (expr::Expression& e : s.g) g_.push_back(std::move(e));
     for (auto& field : s.F) fields_.push_back(std::move(field));
+    if (!s.f_alpha.empty()) f_alpha_ = std::move(s.f_alpha);
+  }
+}
+
+void ExpressionModel::set_vertices(const Eigen::MatrixXd& S) {
+  vertices_.clear();
+  fields_.clear();
+  for (Eigen::Index i = 0; i < S.rows(); ++i) {
+    std::vector<double> v;
+    for (Eigen::Index j = 0; j < S.cols(); ++j) v.push_back(S(i, j) > 0 ? 1.0 : 0.0);
+    vertices_.push_back(std::move(v));
+    fields_.push_back(f_alpha_);
   }
 }
 
 template <class T>
 void ExpressionModel::eval_list(const std::vector<expr::Expression>& list, const T* x, const T* u,
-                                const T* p, T* out) const {
+                                const T* p, T* out, const T* alpha, const double* vertex) const {
   SymbolBuffer<T> in(layout_.n_symbols());
   in.push_range(x, layout_.n_x);
   in.push_zeros(layout_.n_x_slots - layout_.n_x);
@@ -136,19 +157,31 @@ void ExpressionModel::eval_list(const std::vector<expr::Expression>& list, const
     in.push_zeros(layout_.n_z());
     layout_.algebraic->solve<T>(in.data());
   }
+  if (alpha != nullptr)
+    in.push_range(alpha, layout_.n_alpha);
+  else if (vertex != nullptr)
+    for (int j = 0; j < layout_.n_alpha; ++j) in.push(T(vertex[j]));
+  else
+    in.push_zeros(layout_.n_alpha);
   const T* symbols = in.data();
   for (std::size_t i = 0; i < list.size(); ++i) out[i] = list[i].template evaluate<T>(symbols);
 }
 
-#define FESD_DEFINE_EXPRESSION_FUNCTIONS(T)                                                 \
-  void ExpressionModel::c(const T* x, const T* p, T* c_out) const {                         \
-    eval_list<T>(c_, x, nullptr, p, c_out);                                                 \
-  }                                                                                         \
-  void ExpressionModel::g(const T* x, const T* p, T* g_out) const {                         \
-    eval_list<T>(g_, x, nullptr, p, g_out);                                                 \
-  }                                                                                         \
-  void ExpressionModel::f(int region, const T* x, const T* u, const T* p, T* f_out) const { \
-    eval_list<T>(fields_.at(static_cast<std::size_t>(region)), x, u, p, f_out);             \
+#define FESD_DEFINE_EXPRESSION_FUNCTIONS(T)                                                   \
+  void ExpressionModel::c(const T* x, const T* p, T* c_out) const {                           \
+    eval_list<T>(c_, x, nullptr, p, c_out);                                                   \
+  }                                                                                           \
+  void ExpressionModel::g(const T* x, const T* p, T* g_out) const {                           \
+    eval_list<T>(g_, x, nullptr, p, g_out);                                                   \
+  }                                                                                           \
+  void ExpressionModel::f(int region, const T* x, const T* u, const T* p, T* f_out) const {   \
+    const auto r = static_cast<std::size_t>(region);                                          \
+    eval_list<T>(fields_.at(r), x, u, p, f_out, nullptr,                                      \
+                 vertices_.empty() ? nullptr : vertices_.at(r).data());                       \
+  }                                                                                           \
+  void ExpressionModel::f_alpha(const T* x, const T* alpha, const T* u, const T* p, T* f_out) \
+      const {                                                                                 \
+    eval_list<T>(f_alpha_, x, u, p, f_out, alpha);                                            \
   }
 FESD_FOR_EACH_SCALAR(FESD_DEFINE_EXPRESSION_FUNCTIONS)
 #undef FESD_DEFINE_EXPRESSION_FUNCTIONS
@@ -166,7 +199,7 @@ void ExpressionModel::algebraic(const double* x, const double* u, const double* 
   in.push_range(p, layout_.n_p);
   in.push_zeros(layout_.n_z());
   layout_.algebraic->solve<double>(in.data());
-  std::copy_n(in.data() + layout_.n_symbols() - layout_.n_z(), layout_.n_z(), z);
+  std::copy_n(in.data() + layout_.n_symbols() - layout_.n_alpha - layout_.n_z(), layout_.n_z(), z);
 }
 
 Pss make_expression_pss(PssDims dims, ExpressionLayout layout,
@@ -188,14 +221,19 @@ Pss make_expression_pss(PssDims dims, ExpressionLayout layout,
           fmt::format("internal: expression model: subsystem {}: n_c = {}, n_g = {} but {} c "
                       "and {} g expressions",
                       k, d.n_c, d.n_g, s.c.size(), s.g.size()));
-    if (d.n_f() != static_cast<int>(s.F.size()))
+    if (s.f_alpha.empty() && d.n_f() != static_cast<int>(s.F.size()))
       throw InternalError(
           fmt::format("internal: expression model: subsystem {}: {} regions but {} vector "
                       "fields F",
                       k, d.n_f(), s.F.size()));
   }
-  auto functions = std::make_shared<const ExpressionModel>(layout, std::move(subsystems));
-  return Pss(std::move(dims), std::move(functions));
+  const bool by_alpha = !subsystems.front().f_alpha.empty();
+  auto functions = std::make_shared<ExpressionModel>(layout, std::move(subsystems));
+  if (by_alpha) {
+    const Subsystem& d = dims.subsystems.front();
+    functions->set_vertices(d.S.size() > 0 ? d.S : all_sign_rows(d.n_c));
+  }
+  return Pss(std::move(dims), std::shared_ptr<const ExpressionModel>(std::move(functions)));
 }
 
 }  // namespace fesd
