@@ -41,6 +41,7 @@
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
+#include "core/accuracy_options.hpp"
 #include "core/option_registry.hpp"
 #include "fesd/error.hpp"
 #include "fesd/integrator.hpp"
@@ -398,11 +399,7 @@ void print_header(const fesd::SimulationProblem& problem) {
   if (problem.u.size() > 0)
     out::print("  u           {}\n", join_vector(problem.u, problem.model.control_names));
   print_solver_header(std::to_string(o.discretization.N_FE), o.discretization, o.homotopy, o.nlp);
-  fesd::AccuracyOptions accuracy;
-  accuracy.tol_sim = problem.tol_sim;
-  accuracy.N_sim = problem.N_sim;
-  accuracy.N_sim_max = problem.N_sim_max;
-  accuracy.error_estimate = problem.error_estimate;
+  const fesd::AccuracyOptions accuracy = fesd::accuracy_options(problem);
   out::print("  simulation  T_sim = {:g}, {}; fix_active_set = {}\n", problem.T_sim,
              fesd::format_accuracy_rule(accuracy, problem.T_sim),
              yes_no(o.homotopy.fix_active_set));
@@ -617,14 +614,9 @@ void print_header(const fesd::PdsSimulationProblem& problem) {
   print_pds_header(problem, "projected dynamical system",
                    fmt::format("n_c = {}", problem.model.n_c()), problem.model, problem.x0,
                    problem.options.discretization);
-  fesd::AccuracyOptions a;
-  a.tol_sim = problem.tol_sim;
-  a.N_sim = problem.N_sim;
-  a.N_sim_max = problem.N_sim_max;
-  a.error_estimate = problem.error_estimate;
   out::print("  simulation  T_sim = {:g}{}, {}\n", problem.T_sim,
              problem.t0 != 0 ? fmt::format(" from t0 = {:g}", problem.t0) : "",
-             fesd::format_accuracy_rule(a, problem.T_sim));
+             fesd::format_accuracy_rule(fesd::accuracy_options(problem), problem.T_sim));
 }
 
 void print_header(const fesd::PdsOcpProblem& problem) {

@@ -23,6 +23,7 @@
 
 #include <fmt/format.h>
 
+#include "core/accuracy_options.hpp"
 #include "core/limits.hpp"
 #include "core/option_registry.hpp"
 #include "fesd/error.hpp"
@@ -429,11 +430,7 @@ void shift_times(IntegratorResult& r, double t0) {
 
 IntegratorResult simulate(const SimulationProblem& q,
                           const std::function<void(const AccuracyRun&)>& on_run) {
-  AccuracyOptions a;
-  a.tol_sim = q.tol_sim;
-  a.N_sim = q.N_sim;
-  a.N_sim_max = q.N_sim_max;
-  a.error_estimate = q.error_estimate;
+  AccuracyOptions a = accuracy_options(q);
   a.on_run = on_run;
   return simulate(q.model, q.x0, q.T_sim, a, q.options, q.u, q.p);
 }

@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
+#include "core/accuracy_options.hpp"
 #include "fesd/error.hpp"
 #include "fesd/problem_file.hpp"
 #include "io/option_target.hpp"
@@ -227,11 +228,7 @@ PdsSimulationProblem load_pds_simulation_problem(const std::string& path) {
 
 IntegratorResult simulate(const PdsSimulationProblem& q,
                           const std::function<void(const AccuracyRun&)>& on_run) {
-  AccuracyOptions a;
-  a.tol_sim = q.tol_sim;
-  a.N_sim = q.N_sim;
-  a.N_sim_max = q.N_sim_max;
-  a.error_estimate = q.error_estimate;
+  AccuracyOptions a = accuracy_options(q);
   a.on_run = on_run;
   IntegratorResult r = simulate(q.model, q.x0, q.T_sim, a, q.options, q.u, q.p, q.pds);
   shift_times(r, q.t0);

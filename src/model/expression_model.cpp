@@ -62,6 +62,24 @@ int max_dependency(const expr::Expression& e) {
   return deps.empty() ? -1 : deps.back();
 }
 
+/// The symbols every expression reads before the step form's alpha: x (and the unused time slot),
+/// u (zeros where the caller has none: c, g), p, and z = z(x, u, p) solved from g_z = 0.
+template <class T>
+void push_x_u_p_z(SymbolBuffer<T>& in, const ExpressionLayout& layout, const T* x, const T* u,
+                  const T* p) {
+  in.push_range(x, layout.n_x);
+  in.push_zeros(layout.n_x_slots - layout.n_x);
+  if (u != nullptr)
+    in.push_range(u, layout.n_u);
+  else
+    in.push_zeros(layout.n_u);
+  in.push_range(p, layout.n_p);
+  if (layout.algebraic) {
+    in.push_zeros(layout.n_z());
+    layout.algebraic->solve<T>(in.data());
+  }
+}
+
 }  // namespace
 
 ExpressionModel::ExpressionModel(ExpressionLayout layout,
@@ -146,17 +164,7 @@ template <class T>
 void ExpressionModel::eval_list(const std::vector<expr::Expression>& list, const T* x, const T* u,
                                 const T* p, T* out, const T* alpha, const double* vertex) const {
   SymbolBuffer<T> in(layout_.n_symbols());
-  in.push_range(x, layout_.n_x);
-  in.push_zeros(layout_.n_x_slots - layout_.n_x);
-  if (u != nullptr)
-    in.push_range(u, layout_.n_u);
-  else
-    in.push_zeros(layout_.n_u);
-  in.push_range(p, layout_.n_p);
-  if (layout_.algebraic) {
-    in.push_zeros(layout_.n_z());
-    layout_.algebraic->solve<T>(in.data());
-  }
+  push_x_u_p_z(in, layout_, x, u, p);
   if (alpha != nullptr)
     in.push_range(alpha, layout_.n_alpha);
   else if (vertex != nullptr)
@@ -190,15 +198,7 @@ void ExpressionModel::algebraic(const double* x, const double* u, const double* 
                                 double* z) const {
   if (!layout_.algebraic) return;
   SymbolBuffer<double> in(layout_.n_symbols());
-  in.push_range(x, layout_.n_x);
-  in.push_zeros(layout_.n_x_slots - layout_.n_x);
-  if (u != nullptr)
-    in.push_range(u, layout_.n_u);
-  else
-    in.push_zeros(layout_.n_u);
-  in.push_range(p, layout_.n_p);
-  in.push_zeros(layout_.n_z());
-  layout_.algebraic->solve<double>(in.data());
+  push_x_u_p_z(in, layout_, x, u, p);
   std::copy_n(in.data() + layout_.n_symbols() - layout_.n_alpha - layout_.n_z(), layout_.n_z(), z);
 }
 
