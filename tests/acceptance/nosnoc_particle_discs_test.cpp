@@ -129,4 +129,66 @@ TEST(NosnocParticleDiscs, DiscsContactFieldConservesMomentumAndDissipates) {
   EXPECT_EQ(f[8], u[2]);
 }
 
+// The discs file with its control fixed (an impact test of the discretized model, cheap enough
+// for the suite; the OCP itself is in docs/nosnoc-examples.md): disc 1 pushed straight at disc 2
+// by ux = -4 (sot = 1, uy = 0) for 2.5 s, 10 intervals. Exact properties: disc 2 rests at (-1, 0)
+// until disc 1 touches it (only contact moves it); the discs never overlap (f_c >= 0); during
+// the impact (the contact region alone: th2 = 1) positions stand still, the total momentum is
+// conserved and the kinetic energy falls (inelastic: the normal impulse ends at v_n = 0); after
+// it the two move together along the x axis (v_n = 0: equal x velocities); the clock reads
+// k T / N_stages at every interval end. Measured: touch at tau = 1.928, f_c >= -2.5e-8, momentum
+// over the pure-contact element to 3e-8 (-3.1688), positions there to 9e-8, kinetic energy
+// 2.510 -> 1.760; disc 2 before the touch at rest to 2e-8 (the relaxed products th lambda <=
+// sigma_N = 1e-8 leave a contact weight of that order); v1x = v2x = -1.003747 at T.
+TEST(NosnocParticleDiscs, DiscsImpactIsInelasticAndConservesMomentum) {
+  fesd::OcpProblem p = fesd::load_ocp_problem(example_path("disc_switch_places.toml"));
+  fesd::apply_override(p, "T", "2.5");
+  fesd::apply_override(p, "N_stages", "10");
+  fesd::apply_override(p, "N_homotopy", "0");
+  p.ocp.lbu = Eigen::Vector3d(-4.0, 0.0, 1.0);
+  p.ocp.ubu = p.ocp.lbu;
+  p.ocp.u_guess = p.ocp.lbu;
+  const fesd::OcpResult r = fesd::solve(p.ocp, p.options);
+  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+  auto gap = [](const Eigen::VectorXd& x) {
+    return std::pow(x[0] - x[2], 2) + std::pow(x[1] - x[3], 2) - 0.25;
+  };
+  auto momentum = [](const Eigen::VectorXd& x) {
+    return Eigen::Vector2d(2 * x[4] + x[6], 2 * x[5] + x[7]);
+  };
+  auto kinetic = [](const Eigen::VectorXd& x) {
+    return x[4] * x[4] + x[5] * x[5] + 0.5 * (x[6] * x[6] + x[7] * x[7]);
+  };
+  bool touched = false;
+  int contact_elements = 0;
+  for (std::size_t i = 0; i < r.x.size(); ++i) {
+    const Eigen::VectorXd& x = r.x[i];
+    EXPECT_GE(gap(x), -1e-6) << i;
+    if (gap(x) < 1e-6) touched = true;
+    if (!touched) {
+      EXPECT_NEAR(x[2], -1.0, 1e-6) << i;
+      EXPECT_NEAR(x[6], 0.0, 1e-6) << i;
+    }
+    EXPECT_NEAR(x[1], 0.0, 1e-9) << i;
+    EXPECT_NEAR(x[3], 0.0, 1e-9) << i;
+  }
+  for (const Eigen::VectorXd& x : r.x_stage) EXPECT_GE(gap(x), -1e-6);
+  ASSERT_TRUE(touched);
+  for (std::size_t n = 0; n < r.h.size(); ++n) {
+    const Eigen::VectorXd& a = r.alpha[n];  // n_s = 1: one stage per element
+    const double th2 = (1 - a[0]) * (1 - a[1]);
+    if (th2 < 1 - 1e-6 || r.h[n] < 1e-6) continue;
+    ++contact_elements;
+    const Eigen::VectorXd& x0 = r.x[n];
+    const Eigen::VectorXd& x1 = r.x[n + 1];
+    EXPECT_NEAR((x1.head(4) - x0.head(4)).norm(), 0.0, 1e-6) << n;
+    EXPECT_NEAR((momentum(x1) - momentum(x0)).norm(), 0.0, 1e-6) << n;
+    EXPECT_LT(kinetic(x1), kinetic(x0)) << n;
+  }
+  EXPECT_GE(contact_elements, 1);
+  EXPECT_NEAR(r.x_final()[4], r.x_final()[6], 1e-6);
+  EXPECT_LT(r.x_final()[4], -0.5);
+  for (int k = 0; k <= 10; ++k) EXPECT_NEAR(state_at(r, 0.25 * k)[8], 0.25 * k, 1e-9) << k;
+}
+
 }  // namespace
