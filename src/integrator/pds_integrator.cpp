@@ -172,7 +172,8 @@ IntegratorResult integrate(const Pds& model, const Eigen::VectorXd& x0, double T
   mpcc.relax(options.homotopy.mpcc_mode);
   mpcc.fix(in.q, u);
   mpcc.fix(in.p, p);
-  std::unique_ptr<nlp::NlpSolver> solver = nlp::make_solver(options.nlp);
+  std::unique_ptr<nlp::NlpSolver> solver =
+      nlp::make_solver(discretization::pds_nlp_options(options.nlp));
 
   res.t.push_back(0.0);
   res.x.push_back(x0);
