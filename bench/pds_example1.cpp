@@ -102,6 +102,7 @@ void print_fit(const char* name, const Fit& f, const std::string& expected, bool
 fesd::RkScheme g_scheme = fesd::RkScheme::RadauIIA;
 fesd::PdsOptions g_pds;
 fesd::HomotopyOptions g_homotopy;
+double g_gamma_h = -1, g_rho_h = -1;
 bool g_rows = false;
 int g_print_level = 0;
 std::vector<std::pair<std::string, std::string>> g_ipopt;
@@ -119,6 +120,8 @@ Run run(int n_s, int N_FE, int N_sim, bool fesd) {
   o.discretization.N_FE = N_FE;
   o.discretization.use_fesd = fesd;
   o.homotopy = g_homotopy;
+  if (g_gamma_h > 0) o.discretization.gamma_h = g_gamma_h;
+  if (g_rho_h > 0) o.discretization.rho_h = g_rho_h;
   o.nlp.print_level = g_print_level;
   o.nlp.extra = g_ipopt;
   Run r;
@@ -199,6 +202,10 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--ipopt") && std::strchr(argv[i + 1], '=')) {
       const std::string kv = argv[i + 1];
       g_ipopt.emplace_back(kv.substr(0, kv.find('=')), kv.substr(kv.find('=') + 1));
+    } else if (!std::strcmp(argv[i], "--gamma_h")) {
+      g_gamma_h = std::stod(argv[i + 1]);
+    } else if (!std::strcmp(argv[i], "--rho_h")) {
+      g_rho_h = std::stod(argv[i + 1]);
     } else if (!std::strcmp(argv[i], "--rows"))
       g_rows = std::stoi(argv[i + 1]) != 0;
     else if (!std::strcmp(argv[i], "--print_level"))
