@@ -116,7 +116,7 @@ TEST(PdsProblemFile, StartTimeOffsetsEveryTime) {
 // then x = 1 + sin t: x(2 pi) = 1. Radau IIA n_s = 2, N_FE = 20, measured: |x(2 pi) - 1| =
 // 1.8e-5, contact 3.9e-6 off, leaving < 1e-9 off.
 TEST(PdsProblemFile, TimeInTheVectorFieldIsAClockFromT0) {
-  const std::string text = R"(
+  const std::string text = R"toml(
 [model]
 kind = "projected"
 x = ["x"]
@@ -131,7 +131,7 @@ error_estimate = false
 [discretization]
 n_s = 2
 N_finite_elements = 20
-)";
+)toml";
   const double pi = 3.141592653589793;
   fesd::PdsSimulationProblem q = fesd::parse_pds_simulation_problem(text, "f.toml");
   EXPECT_TRUE(q.has_clock);
