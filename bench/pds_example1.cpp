@@ -18,6 +18,7 @@
 #include <limits>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "pds_example1_model.hpp"
@@ -100,6 +101,11 @@ void print_fit(const char* name, const Fit& f, const std::string& expected, bool
 
 fesd::RkScheme g_scheme = fesd::RkScheme::RadauIIA;
 fesd::PdsOptions g_pds;
+fesd::HomotopyOptions g_homotopy;
+double g_gamma_h = -1, g_rho_h = -1;
+bool g_rows = false;
+int g_print_level = 0;
+std::vector<std::pair<std::string, std::string>> g_ipopt;
 
 struct Run {
   double err = NAN, contact = NAN, leave = NAN, wall = 0;
@@ -113,6 +119,11 @@ Run run(int n_s, int N_FE, int N_sim, bool fesd) {
   o.discretization.n_s = n_s;
   o.discretization.N_FE = N_FE;
   o.discretization.use_fesd = fesd;
+  o.homotopy = g_homotopy;
+  if (g_gamma_h > 0) o.discretization.gamma_h = g_gamma_h;
+  if (g_rho_h > 0) o.discretization.rho_h = g_rho_h;
+  o.nlp.print_level = g_print_level;
+  o.nlp.extra = g_ipopt;
   Run r;
   const auto t0 = std::chrono::steady_clock::now();
   const auto res = fesd::integrate(pds_example1::model(), pds_example1::x0(), pds_example1::kT,
@@ -121,6 +132,13 @@ Run run(int n_s, int N_FE, int N_sim, bool fesd) {
   r.ok = res.status == fesd::Status::Success;
   r.nlps = res.summary.homotopy_steps;
   r.iters = res.summary.nlp_iterations;
+  if (g_rows)
+    for (const auto& step : res.homotopy)
+      for (const auto& row : step)
+        std::printf("       NLP %2d sigma %8.1e comp %8.1e obj %10.3e inf_pr %8.1e it %4d %s%s\n",
+                    row.k, row.sigma, row.comp_residual, row.objective, row.inf_pr,
+                    row.nlp_iterations, row.nlp_status.c_str(),
+                    row.active_set_fixed ? " (active set fixed)" : "");
   if (!r.ok) return r;
   r.err = (res.x_final() - pds_example1::x_T()).norm();
   for (const auto& s : res.switches) {
@@ -179,6 +197,19 @@ int main(int argc, char** argv) {
       nsim = parse_list(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--M"))
       g_pds.M = std::stod(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--intermediate_tol"))
+      g_homotopy.intermediate_tol = std::stod(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--ipopt") && std::strchr(argv[i + 1], '=')) {
+      const std::string kv = argv[i + 1];
+      g_ipopt.emplace_back(kv.substr(0, kv.find('=')), kv.substr(kv.find('=') + 1));
+    } else if (!std::strcmp(argv[i], "--gamma_h")) {
+      g_gamma_h = std::stod(argv[i + 1]);
+    } else if (!std::strcmp(argv[i], "--rho_h")) {
+      g_rho_h = std::stod(argv[i + 1]);
+    } else if (!std::strcmp(argv[i], "--rows"))
+      g_rows = std::stoi(argv[i + 1]) != 0;
+    else if (!std::strcmp(argv[i], "--print_level"))
+      g_print_level = std::stoi(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--method") && !std::strcmp(argv[i + 1], "fesd"))
       g_standard = false;
     else if (!std::strcmp(argv[i], "--method") && !std::strcmp(argv[i + 1], "standard"))

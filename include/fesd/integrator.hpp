@@ -151,6 +151,11 @@ struct AccuracyOptions {
   std::function<void(const AccuracyRun&)> on_run;
 };
 
+/// Adds t0 to every time of a result that starts at 0 (t, t_stage, the switches, the switch times
+/// of accuracy.runs): the result of a simulation that starts at t0 (`[simulation] t0` of both
+/// kinds of problem files: every time of their results is absolute).
+void shift_times(IntegratorResult& result, double t0);
+
 /// Simulates like integrate() with a step count chosen by AccuracyOptions and estimates the error
 /// of the result (IntegratorResult::accuracy) from runs at several N_sim (docs/problem-files.md,
 /// "Accuracy"). Returns the run at the given N_sim, or the last run of a search for tol_sim;

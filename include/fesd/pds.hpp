@@ -175,8 +175,4 @@ IntegratorResult simulate(const Pds& model, const Eigen::VectorXd& x0, double T_
                           const Eigen::VectorXd& u = {}, const Eigen::VectorXd& p = {},
                           const PdsOptions& pds = {});
 
-/// Adds t0 to every time of a result that starts at 0 (t, t_stage, the switches, the switch times
-/// of accuracy.runs): the result of a simulation that starts at t0 (projected files' t0).
-void shift_times(IntegratorResult& result, double t0);
-
 }  // namespace fesd

@@ -29,6 +29,9 @@ struct PdsSimulationProblem {
   int N_sim_max = 1000;  ///< [simulation] N_sim_max
   bool error_estimate = true;  ///< [simulation] error_estimate
   double t0 = 0;  ///< [simulation] t0: the start time; every time of the result is offset by it
+  /// True if f reads the time `t`: then a clock state "t" with t' = 1 is the last state of the
+  /// model (as in piecewise smooth files), and x0's last entry is t0.
+  bool has_clock = false;
   IntegratorOptions options;
   PdsOptions pds;
 };

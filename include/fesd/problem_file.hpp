@@ -34,6 +34,9 @@ struct SimulationProblem {
   /// True if an expression uses the time `t`: then a clock state named "t" with t' = 1 is
   /// appended to x (nosnoc does the same), and its initial value is [simulation] t0 (default 0).
   bool has_clock = false;
+  /// [simulation] t0 (default 0): the start time. The clock state (if any) starts at t0, and
+  /// every time of the result of simulate() is absolute (offset by t0), as for projected files.
+  double t0 = 0;
 };
 
 /// Simulates the problem with simulate(): N_sim steps, or as many as tol_sim needs, with an

@@ -84,6 +84,17 @@ std::vector<int> range(int first, int n) {
 
 }  // namespace
 
+NlpOptions pds_nlp_options(const NlpOptions& o) {
+  NlpOptions out = o;
+  for (const char* name :
+       {"warm_start_bound_push", "warm_start_slack_bound_push", "warm_start_mult_bound_push"}) {
+    const bool given = std::any_of(out.extra.begin(), out.extra.end(),
+                                   [&](const auto& kv) { return kv.first == name; });
+    if (!given) out.extra.emplace_back(name, fmt::format("{:g}", kPdsWarmStartPush));
+  }
+  return out;
+}
+
 std::vector<std::string> PdsInterval::errors(const Tableau& tab, const DiscretizationOptions& o,
                                              const PdsOptions& pds) {
   std::vector<std::string> e;

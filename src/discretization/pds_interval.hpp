@@ -37,6 +37,17 @@
 
 namespace fesd::discretization {
 
+/// IPOPT's push of a warm start away from the bounds (warm_start_bound_push,
+/// warm_start_slack_bound_push, warm_start_mult_bound_push) for the NLPs of PDS intervals. IPOPT's
+/// default 1e-3 moves every variable that sits at a bound by up to 1e-3 when an NLP of the
+/// homotopy is warm-started: the multipliers, constraint values and step-equilibration variables
+/// that the previous NLP had driven to O(sigma), among them nu_n, whose bound M nu_n on
+/// |h_{n-1} - h_n| then jumps from O(M sigma) to 1e-3 M = 1e3 (M = 1e6) >> h0: the element lengths
+/// are released and drift (docs/pds.md, "Warm starts").
+inline constexpr double kPdsWarmStartPush = 1e-9;
+/// `o` with the three warm-start pushes set to kPdsWarmStartPush unless [ipopt] sets them.
+NlpOptions pds_nlp_options(const NlpOptions& o);
+
 /// Where the interval's inputs live in the NLP (variables, possibly fixed by their bounds).
 struct PdsIntervalInputs {
   std::vector<int> s0;  ///< n_x: state at the interval start

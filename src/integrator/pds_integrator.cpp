@@ -172,7 +172,11 @@ IntegratorResult integrate(const Pds& model, const Eigen::VectorXd& x0, double T
   mpcc.relax(options.homotopy.mpcc_mode);
   mpcc.fix(in.q, u);
   mpcc.fix(in.p, p);
-  std::unique_ptr<nlp::NlpSolver> solver = nlp::make_solver(options.nlp);
+  // Warm starts with the small pushes of pds_nlp_options(); a step whose homotopy fails is solved
+  // once more from the same guess with IPOPT's own pushes (Summary::fallback_steps).
+  std::unique_ptr<nlp::NlpSolver> solver =
+      nlp::make_solver(discretization::pds_nlp_options(options.nlp));
+  std::unique_ptr<nlp::NlpSolver> fallback_solver;
 
   res.t.push_back(0.0);
   res.x.push_back(x0);
@@ -189,11 +193,20 @@ IntegratorResult integrate(const Pds& model, const Eigen::VectorXd& x0, double T
       res.summary.setup_s = seconds_since(t_start);
     }
     mpcc::HomotopyResult hr = mpcc.solve_homotopy(*solver, options.homotopy);
+    nlp::NlpSolver* step_nlp_solver = solver.get();
+    if (hr.status != Status::Success) {
+      if (!fallback_solver) fallback_solver = nlp::make_solver(options.nlp);
+      mpcc::HomotopyResult again = mpcc.solve_homotopy(*fallback_solver, options.homotopy);
+      if (again.status == Status::Success) ++res.summary.fallback_steps;
+      mpcc::append(hr, again);
+      hr.status = again.status;
+      step_nlp_solver = fallback_solver.get();
+    }
     // The re-solve with the active set of every element fixed (PdsInterval::active_set_bounds);
     // if it fails, the homotopy's solution stays.
     if (hr.status == Status::Success && d.use_fesd && options.homotopy.fix_active_set) {
-      mpcc::HomotopyResult again =
-          mpcc.solve_again(*solver, options.homotopy, iv.active_set_bounds(mpcc.solution().data()));
+      mpcc::HomotopyResult again = mpcc.solve_again(*step_nlp_solver, options.homotopy,
+                                                    iv.active_set_bounds(mpcc.solution().data()));
       const Status homotopy_status = hr.status;
       mpcc::append(hr, again);
       if (again.status == Status::Success) {

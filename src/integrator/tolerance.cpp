@@ -432,7 +432,9 @@ IntegratorResult simulate(const SimulationProblem& q,
                           const std::function<void(const AccuracyRun&)>& on_run) {
   AccuracyOptions a = accuracy_options(q);
   a.on_run = on_run;
-  return simulate(q.model, q.x0, q.T_sim, a, q.options, q.u, q.p);
+  IntegratorResult r = simulate(q.model, q.x0, q.T_sim, a, q.options, q.u, q.p);
+  shift_times(r, q.t0);
+  return r;
 }
 
 std::string format_accuracy_rule(const AccuracyOptions& a, double T_sim) {

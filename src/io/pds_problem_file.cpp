@@ -3,6 +3,7 @@
 // typed reader and the option tables with problem_file.cpp; the [model] table has its own keys.
 #include "fesd/pds_problem_file.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <set>
@@ -50,7 +51,7 @@ std::vector<std::string> validate_all(const PdsSimulationProblem& q) {
 
 namespace io_detail {
 
-PdsModelRead read_pds_model(const Reader& r, const toml::table& root) {
+PdsModelRead read_pds_model(const Reader& r, const toml::table& root, const double* clock_t0) {
   PdsModelRead model_read;
   const toml::node* model_node = root.get("model");
   if (model_node == nullptr)
@@ -109,8 +110,10 @@ PdsModelRead read_pds_model(const Reader& r, const toml::table& root) {
   symbols.insert(symbols.end(), u_names.begin(), u_names.end());
   symbols.insert(symbols.end(), p_names.begin(), p_names.end());
   const int n_x = static_cast<int>(x_names.size()), time_slot = n_x;
+  // f may read t in a simulation (a clock state, below); constraints never (C(t) would be a
+  // moving set, a sweeping process with time-dependent C, which the paper does not treat).
   auto expressions = [&](const toml::node& n, std::string_view path, int length,
-                         std::string_view what) {
+                         std::string_view what, bool time_allowed) {
     const toml::array& a = r.array(n, path, "an array of expressions");
     if (length >= 0 && static_cast<int>(a.size()) != length)
       r.fail(n.source(), path,
@@ -119,33 +122,47 @@ PdsModelRead read_pds_model(const Reader& r, const toml::table& root) {
     std::vector<expr::Expression> out;
     for (std::size_t i = 0; i < a.size(); ++i) {
       out.push_back(r.expression(a[i], index(path, i), symbols));
-      if (out.back().depends_on(time_slot))
+      if (out.back().depends_on(time_slot) && !time_allowed)
         r.fail(a[i].source(), index(path, i),
-               "uses the time t, which projected models do not support yet");
+               clock_t0 == nullptr
+                   ? "uses the time t, which projected optimal control files do not support yet"
+                   : "uses the time t: the set C = {x : constraints(x) >= 0} must not depend on "
+                     "time (papers/fesd-pds.txt treats time-independent sets; t is allowed in f)");
     }
     return out;
   };
   std::vector<expr::Expression> f =
       expressions(required("f", "the vector field, one expression per state"), "model.f", n_x,
-                  "one expression per state in x");
+                  "one expression per state in x", clock_t0 != nullptr);
   std::vector<expr::Expression> c =
       expressions(required("constraints", "the constraints c(x) >= 0 that define C"),
-                  "model.constraints", -1, "at least one constraint c(x) >= 0");
+                  "model.constraints", -1, "at least one constraint c(x) >= 0", false);
   model_read.x0 =
       r.vector(required("x0", "the initial state"), "model.x0", n_x, "one per state in x");
-  ExpressionLayout layout{.n_x = n_x,
+  // The clock: t' = 1 appended to f, t0 to x0; the symbol t then reads state n_x (the slot after
+  // the user's states). grad c has no t component (no constraint reads t).
+  model_read.has_clock = std::any_of(
+      f.begin(), f.end(), [&](const expr::Expression& e) { return e.depends_on(time_slot); });
+  const int n_x_all = n_x + (model_read.has_clock ? 1 : 0);
+  if (model_read.has_clock) {
+    f.push_back(expr::Expression::parse("1", symbols, "clock t' = 1"));
+    model_read.x0.conservativeResize(n_x_all);
+    model_read.x0[n_x] = *clock_t0;
+  }
+  ExpressionLayout layout{.n_x = n_x_all,
                           .n_x_slots = n_x + 1,
                           .n_u = static_cast<int>(u_names.size()),
                           .n_p = static_cast<int>(p_names.size())};
   const int n_c = static_cast<int>(c.size());  // (c is moved in the call below)
   try {
-    model_read.model =
-        make_expression_pds(PdsDims{.n_x = n_x, .n_u = layout.n_u, .n_p = layout.n_p, .n_c = n_c},
-                            layout, std::move(f), std::move(c));
+    model_read.model = make_expression_pds(
+        PdsDims{.n_x = n_x_all, .n_u = layout.n_u, .n_p = layout.n_p, .n_c = n_c}, layout,
+        std::move(f), std::move(c));
   } catch (const InvalidModel& e) {
     throw InvalidModel(fmt::format("{}: {}", r.at(model.source()), e.what()));
   }
   model_read.model.state_names = x_names;
+  if (model_read.has_clock) model_read.model.state_names.push_back("t");
   model_read.model.control_names = u_names;
   model_read.model.parameter_names = p_names;
   model_read.p = Eigen::Map<const Eigen::VectorXd>(p_values.data(),
@@ -185,10 +202,15 @@ PdsSimulationProblem parse_pds_simulation_problem(std::string_view toml_text,
   PdsSimulationProblem problem;
   read_name(r, root, source_name, problem);
 
-  PdsModelRead m = read_pds_model(r, root);
+  // t0 first: it is the clock's start value if f reads t.
+  if (const toml::node* sim = root.get("simulation"))
+    if (const toml::table* st = sim->as_table())
+      if (const toml::node* t0 = st->get("t0")) problem.t0 = r.number(*t0, "simulation.t0");
+  PdsModelRead m = read_pds_model(r, root, &problem.t0);
   problem.model = std::move(m.model);
   problem.x0 = std::move(m.x0);
   problem.p = std::move(m.p);
+  problem.has_clock = m.has_clock;
   const int n_u = problem.model.n_u();
   problem.u = Eigen::VectorXd::Zero(n_u);
 
@@ -205,7 +227,6 @@ PdsSimulationProblem parse_pds_simulation_problem(std::string_view toml_text,
     if (table == registry::Table::Simulation) {
       if (const toml::node* un = t.get("u"))
         problem.u = r.vector(*un, "simulation.u", n_u, "one per control in model.u");
-      if (const toml::node* t0 = t.get("t0")) problem.t0 = r.number(*t0, "simulation.t0");
     }
     check_table_keys(r, t, table, kKind);
     read_option_table(r, t, table, kKind, target, options_only.options.nlp.extra);
@@ -239,13 +260,15 @@ namespace io_detail {
 
 bool set_pds_override(const OverrideArg& a, Pds& model,
                       std::vector<std::pair<std::string, std::string>>& ipopt_extra,
-                      Eigen::VectorXd& x0, Eigen::VectorXd& p, Eigen::VectorXd* u) {
+                      Eigen::VectorXd& x0, Eigen::VectorXd& p, Eigen::VectorXd* u, bool has_clock) {
   const std::string_view key = a.option != nullptr ? a.option->key : a.key;
-  const int n_x = model.n_x(), n_u = model.n_u();
+  const int n_x = model.n_x() - (has_clock ? 1 : 0), n_u = model.n_u();
   if (a.table == "ipopt" && !a.key.empty()) {
     set_ipopt_option(ipopt_extra, a.key, a.value);
   } else if ((a.table.empty() || a.table == "model") && a.key == "x0") {
-    x0 = override_vector(a.head, a.value, n_x, "model.x0", "one per state");
+    // the states of model.x; a clock keeps its start value t0
+    Eigen::VectorXd v = override_vector(a.head, a.value, n_x, "model.x0", "one per state");
+    x0.head(n_x) = v;
   } else if (u != nullptr && key == "u") {
     *u = override_vector(a.head, a.value, n_u, "simulation.u", "one per control");
   } else if (set_parameter_override(a, model.parameter_names, p, model.p_default)) {
@@ -277,8 +300,9 @@ void apply_override(PdsSimulationProblem& problem, std::string_view key, std::st
     if (!d) override_error(arg.head, "expected a number");
     if (!std::isfinite(*d)) override_error(arg.head, "must be finite");
     updated.t0 = *d;
+    if (updated.has_clock) updated.x0[updated.x0.size() - 1] = *d;
   } else if (!set_pds_override(arg, updated.model, s.options.nlp.extra, updated.x0, updated.p,
-                               &updated.u)) {
+                               &updated.u, updated.has_clock)) {
     unknown_override(arg, kKind, Pss{});
   }
   updated.options = s.options;

@@ -37,9 +37,8 @@ constexpr std::array<std::string_view, 7> kTopKeys{
 constexpr registry::Use kKind = registry::Use::Simulation;
 
 std::vector<std::string> validate_all(const SimulationProblem& q) {
-  const double t0 = q.has_clock ? q.x0[q.x0.size() - 1] : 0.0;  // the clock starts at t0
-  std::vector<std::string> e =
-      registry::validate_simulation(q.T_sim, q.N_sim, q.tol_sim, q.N_sim_max, t0, q.error_estimate);
+  std::vector<std::string> e = registry::validate_simulation(q.T_sim, q.N_sim, q.tol_sim,
+                                                             q.N_sim_max, q.t0, q.error_estimate);
   std::vector<std::string> options = validate(q.options);
   if (options.empty())  // the limits of build(), docs/problem-files.md "Limits"
     options = discretization::FesdInterval::block_size_errors(q.model, q.options.discretization);
@@ -104,6 +103,7 @@ SimulationProblem parse_simulation_problem(std::string_view toml_text,
   problem.x0 = std::move(built.x0);
   problem.p = std::move(built.p);
   problem.has_clock = has_clock;
+  problem.t0 = t0;
 
   problem.u = Eigen::VectorXd::Zero(problem.model.n_u());
   if (const toml::node* sim = root.get("simulation"))
@@ -133,6 +133,7 @@ void apply_override(SimulationProblem& problem, std::string_view key, std::strin
     const auto d = parse_double(value);
     if (!d) override_error(head, "expected a number");
     if (!std::isfinite(*d)) override_error(head, "must be finite");
+    updated.t0 = *d;
     if (updated.has_clock) updated.x0[updated.x0.size() - 1] = *d;
   } else if (input == "u") {
     updated.u =

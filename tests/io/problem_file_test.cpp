@@ -404,6 +404,37 @@ t0 = 2.5
   expect_vector_near(eval_f(q.model, 0, x, u, p), {0.0, 1.0});
 }
 
+// [simulation] t0 is the start time (docs/problem-files.md, "Results": every time is absolute),
+// as in projected files: the clock (if any) starts at t0 and the result's times are offset by it.
+// Example 3(c) from t0 = 0.5: x' in -sign(x) + t slides on x = 0 until t = 1, then
+// x = (t - 1)^2 / 2, x(2.5) = 1.125; without a clock (x' = -1 from 0.25, then sliding on x = 0) the
+// times start at t0 too.
+TEST(ProblemFile, StartTimeIsAbsoluteWithAndWithoutClock) {
+  SimulationProblem q = load_example("leaving_sliding.toml");
+  apply_override(q, "t0", "0.5");
+  apply_override(q, "error_estimate", "false");
+  EXPECT_EQ(q.t0, 0.5);
+  EXPECT_EQ(q.x0[1], 0.5);
+  const IntegratorResult r = simulate(q);
+  ASSERT_EQ(r.status, Status::Success) << r.message;
+  EXPECT_EQ(r.t.front(), 0.5);
+  EXPECT_NEAR(r.t.back(), 2.5, 1e-12);
+  EXPECT_NEAR(r.x_final()[0], 1.125, 1e-9);
+  for (std::size_t n = 0; n < r.t.size(); ++n) EXPECT_NEAR(r.x[n][1], r.t[n], 1e-9);
+  ASSERT_EQ(r.switches.size(), 1u);
+  EXPECT_NEAR(r.switches[0].t, 1.0, 1e-9);
+
+  SimulationProblem m = parse_simulation_problem(
+      std::string(kMinimal) + "N_sim = 2\nerror_estimate = false\nt0 = 3\n", "t0.toml");
+  EXPECT_FALSE(m.has_clock);
+  EXPECT_EQ(m.t0, 3.0);
+  const IntegratorResult rm = simulate(m);
+  ASSERT_EQ(rm.status, Status::Success) << rm.message;
+  EXPECT_EQ(rm.t.front(), 3.0);
+  EXPECT_NEAR(rm.t.back(), 4.0, 1e-12);
+  EXPECT_NEAR(rm.x_final()[0], 0.0, 1e-9);  // x' = -1 from 0.25, sliding on x = 0 from 3.25
+}
+
 TEST(ProblemFile, CartesianProductOfTwoSubsystems) {
   // Sect. 2.3: x1' in -sign(x1), x2' in -sign(x2) as two independent subsystems; the second in
   // g-form. The clock's t' = 1 is carried by subsystem 0 only, so sum_k F^k theta^k has t' = 1.

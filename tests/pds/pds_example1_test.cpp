@@ -110,14 +110,15 @@ TEST(PdsExample1Standard, FesdMuchMoreAccurateAtEqualElements) {
 // A step that starts sliding on x2 = -1 at (a, -1) and leaves at t = a, 6% before its end: the
 // element after the leaving point is short and c grows quadratically there, so nu_n is ~4e-6
 // (the step of Example 1 that failed with M = 1e3 at N_sim = 100). Exact: x(T) =
-// (-sin(T - a), -cos(T - a)). Measured (n_s = 3, N_FE = 2): error 1e-16, leaving time 3e-16.
+// (-sin(T - a), -cos(T - a)). Measured (n_s = 3, N_FE = 2): error 1e-16, leaving time 3e-16 with
+// IPOPT's warm-start pushes, 4.2e-12 with the small ones (docs/pds.md, "Warm starts").
 TEST(PdsExample1Step, LeavingCloseToTheStepEnd) {
   const double a = 0.04335, T = kT / 100;
   const auto r = fesd::integrate(example1(), Eigen::Vector2d(a, -1.0), T, 1, options(3, 2, true));
   ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
   EXPECT_LT((r.x_final() - Eigen::Vector2d(-std::sin(T - a), -std::cos(T - a))).norm(), 1e-12);
   ASSERT_EQ(r.switches.size(), 1u);
-  EXPECT_NEAR(r.switches[0].t, a, 1e-12);
+  EXPECT_NEAR(r.switches[0].t, a, 1.5e-11);
 }
 
 // FESD with one stage (Radau IIA n_s = 1, implicit Euler; the backward sums of the step

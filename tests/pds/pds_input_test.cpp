@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include "discretization/pds_interval.hpp"
 #include "fesd/error.hpp"
 #include "fesd/pds.hpp"
 
@@ -101,3 +102,23 @@ TEST(PdsInput, LicqFailureAtX0Warns) {
 }
 
 }  // namespace
+
+// The warm starts of PDS steps (docs/pds.md, "Warm starts"): IPOPT's three pushes are 1e-9 unless
+// [ipopt] sets them.
+TEST(PdsWarmStart, SmallPushesUnlessGiven) {
+  fesd::NlpOptions o;
+  o.extra = {{"warm_start_bound_push", "1e-4"}, {"mu_strategy", "monotone"}};
+  const fesd::NlpOptions p = fesd::discretization::pds_nlp_options(o);
+  auto value = [&](const std::string& name) {
+    int found = 0;
+    std::string v;
+    for (const auto& [k, val] : p.extra)
+      if (k == name) ++found, v = val;
+    EXPECT_EQ(found, 1) << name;
+    return v;
+  };
+  EXPECT_EQ(value("warm_start_bound_push"), "1e-4");
+  EXPECT_EQ(value("warm_start_slack_bound_push"), "1e-09");
+  EXPECT_EQ(value("warm_start_mult_bound_push"), "1e-09");
+  EXPECT_EQ(value("mu_strategy"), "monotone");
+}

@@ -110,6 +110,55 @@ TEST(PdsProblemFile, StartTimeOffsetsEveryTime) {
   EXPECT_EQ(o.t0, -2.5);
 }
 
+// The time t in f (issue 16): a clock state t' = 1 is appended as in piecewise smooth files, it
+// starts at t0, and the result's times are absolute. x' = cos(t) on C = {x >= 0} from x(pi) = 0.5:
+// x = 0.5 + sin t until contact at 7 pi/6, sliding on x = 0 while cos t < 0, leaving at 3 pi/2,
+// then x = 1 + sin t: x(2 pi) = 1. Radau IIA n_s = 2, N_FE = 20, measured: |x(2 pi) - 1| =
+// 1.8e-5, contact 3.9e-6 off, leaving < 1e-9 off.
+TEST(PdsProblemFile, TimeInTheVectorFieldIsAClockFromT0) {
+  const std::string text = R"toml(
+[model]
+kind = "projected"
+x = ["x"]
+f = ["cos(t)"]
+constraints = ["x"]
+x0 = [0.5]
+[simulation]
+T_sim = 3.141592653589793
+t0 = 3.141592653589793
+N_sim = 1
+error_estimate = false
+[discretization]
+n_s = 2
+N_finite_elements = 20
+)toml";
+  const double pi = 3.141592653589793;
+  fesd::PdsSimulationProblem q = fesd::parse_pds_simulation_problem(text, "f.toml");
+  EXPECT_TRUE(q.has_clock);
+  ASSERT_EQ(q.model.n_x(), 2);
+  EXPECT_EQ(q.model.state_names.back(), "t");
+  EXPECT_EQ(q.x0[1], pi);
+  const fesd::IntegratorResult r = fesd::simulate(q);
+  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+  EXPECT_NEAR(r.x_final()[0], 1.0, 6e-5);
+  EXPECT_NEAR(r.x_final()[1], 2 * pi, 1e-9);  // the clock
+  EXPECT_EQ(r.t.front(), pi);
+  EXPECT_NEAR(r.t.back(), 2 * pi, 1e-12);
+  for (std::size_t n = 0; n < r.t.size(); ++n) EXPECT_NEAR(r.x[n][1], r.t[n], 1e-9);
+  ASSERT_EQ(r.switches.size(), 2u);
+  EXPECT_NEAR(r.switches[0].t, 7 * pi / 6, 1.2e-5);
+  EXPECT_NEAR(r.switches[1].t, 1.5 * pi, 1e-6);
+
+  // --x0 sets the states of model.x (the clock keeps t0), --t0 the start time and the clock.
+  fesd::apply_override(q, "x0", "0.25");
+  EXPECT_EQ(q.x0[0], 0.25);
+  EXPECT_EQ(q.x0[1], pi);
+  fesd::apply_override(q, "t0", "1.5");
+  EXPECT_EQ(q.t0, 1.5);
+  EXPECT_EQ(q.x0[1], 1.5);
+  EXPECT_THROW(fesd::apply_override(q, "x0", "0.25,1"), fesd::InvalidOption);
+}
+
 // [simulation] tol_sim (issue 16): N_sim chosen by step doubling as for piecewise smooth files.
 // Example 1 with Radau IIA n_s = 2 (order 3), N_FE = 10, from N_sim = 1: measured runs N_sim =
 // 1, 2, 8, 19, estimate 5.3e-7, true error 5.4e-7. Asserted: the error <= tol_sim = 1e-6 and the
