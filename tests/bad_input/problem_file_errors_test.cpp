@@ -5,6 +5,7 @@
 //   # expect: <ProblemFileError | ExpressionError | InvalidOption | InvalidModel>
 //   # message: <a substring the message must contain>      (one or more lines)
 //   # loader: ocp                                          (optional: load_ocp_problem)
+//   # loader: pds_ocp                                      (optional: load_pds_ocp_problem)
 // and the test loads it (with load_simulation_problem unless the header names the OCP loader) and
 // checks both. Overrides (apply_override) are checked inline below.
 #include <algorithm>
@@ -16,6 +17,7 @@
 
 #include <gtest/gtest.h>
 #include <fesd/error.hpp>
+#include <fesd/pds_problem_file.hpp>
 #include <fesd/problem_file.hpp>
 
 namespace fesd {
@@ -74,11 +76,14 @@ TEST_P(BadProblemFile, ThrowsWithMessage) {
   }
   ASSERT_FALSE(expect_kind.empty()) << path << ": no '# expect:' header";
   ASSERT_FALSE(expect_messages.empty()) << path << ": no '# message:' header";
-  ASSERT_TRUE(loader == "simulation" || loader == "ocp") << path << ": unknown loader " << loader;
+  ASSERT_TRUE(loader == "simulation" || loader == "ocp" || loader == "pds_ocp")
+      << path << ": unknown loader " << loader;
 
   const Outcome o = outcome_of([&] {
     if (loader == "ocp")
       load_ocp_problem(path);
+    else if (loader == "pds_ocp")
+      load_pds_ocp_problem(path);
     else
       load_simulation_problem(path);
   });
