@@ -19,6 +19,8 @@
 //   term template <class T> void g_path(const T* x, const T* u, const T* p, T* out) const; template
 //   <class T> void g_terminal(const T* x, const T* p, T* out) const; template <class T> void
 //   g_path_comp(const T* x, const T* u, const T* p, T* out) const;  // a, then b
+//   template <class T> void g_rk_comp(const T* x, const T* u, const T* p, const T* y, T* out)
+//   const;  // a, then b, at the RK stage points; y: the stage's theta, ... (RkAlgebraic)
 //
 // Example (the sensitivity OCP (56): min int_0^2 x^2 dt + (x(2) - 5/3)^2 over x0):
 //
@@ -36,6 +38,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -59,14 +62,58 @@ class OcpFunctions {
   virtual bool has_f_q_T() const = 0;
   /// Path complementarity pairs (OcpData::n_g_path_comp of them): out[i] = a_i(x, u, p),
   /// out[n + i] = b_i(x, u, p), for 0 <= a_i perp b_i >= 0. Optional (the default writes nothing).
-#define FESD_DECLARE_OCP_FUNCTIONS(T)                                        \
-  virtual T f_q(const T* x, const T* u, const T* p) const = 0;               \
-  virtual T f_q_T(const T* x, const T* p) const = 0;                         \
-  virtual void g_path(const T* x, const T* u, const T* p, T* out) const = 0; \
-  virtual void g_terminal(const T* x, const T* p, T* out) const = 0;         \
-  virtual void g_path_comp(const T* /*x*/, const T* /*u*/, const T* /*p*/, T* /*out*/) const {}
+#define FESD_DECLARE_OCP_FUNCTIONS(T)                                                           \
+  virtual T f_q(const T* x, const T* u, const T* p) const = 0;                                  \
+  virtual T f_q_T(const T* x, const T* p) const = 0;                                            \
+  virtual void g_path(const T* x, const T* u, const T* p, T* out) const = 0;                    \
+  virtual void g_terminal(const T* x, const T* p, T* out) const = 0;                            \
+  virtual void g_path_comp(const T* /*x*/, const T* /*u*/, const T* /*p*/, T* /*out*/) const {} \
+  virtual void g_rk_comp(const T* /*x*/, const T* /*u*/, const T* /*p*/, const T* /*y*/,        \
+                         T* /*out*/) const {}
   FESD_FOR_EACH_SCALAR(FESD_DECLARE_OCP_FUNCTIONS)
 #undef FESD_DECLARE_OCP_FUNCTIONS
+  // g_rk_comp (above): the stage complementarity pairs (OcpData::n_g_rk_comp of them), out[i] =
+  // a_i(x, u, p, y), out[n + i] = b_i(x, u, p, y) at an RK stage point, y the stage's DCS
+  // algebraic variables in the RkAlgebraic layout. Optional (the default writes nothing).
+  /// The entries of y (indices into the RkAlgebraic layout) that g_rk_comp reads; empty: every
+  /// entry that the discretization's form has (RkAlgebraic::exists).
+  virtual std::vector<int> g_rk_comp_inputs() const {
+    return {};
+  }
+};
+
+/// The DCS algebraic variables of one RK stage point that OcpFunctions::g_rk_comp reads, one layout
+/// for both forms of DiscretizationOptions::dcs_mode (nosnoc's names, 1-based in problem files):
+///
+///   y = [ theta_1 .. theta_{n_theta},  lambda_1 .. lambda_{n_theta},
+///         alpha_1 .. alpha_{n_c},  lambda_n_1 .. lambda_n_{n_c},  lambda_p_1 .. lambda_p_{n_c} ]
+///
+/// theta: Stewart's region weights, in the step form theta(alpha) (both forms); lambda: Stewart's
+/// multipliers (Stewart only); alpha, lambda_n, lambda_p: the step form's (step only). The entries
+/// a form does not have are 0.
+struct RkAlgebraic {
+  int n_theta = 0;  ///< regions of the model (all subsystems)
+  int n_c = 0;      ///< switching functions of the model (all c-form subsystems)
+  enum class Kind { Theta, Lambda, Alpha, LambdaN, LambdaP };
+  int size() const { return 2 * n_theta + 3 * n_c; }
+  /// The kind of entry i and its index within the kind (0-based).
+  std::pair<Kind, int> entry(int i) const {
+    if (i < n_theta) return {Kind::Theta, i};
+    if (i < 2 * n_theta) return {Kind::Lambda, i - n_theta};
+    const int j = i - 2 * n_theta;
+    return {j < n_c ? Kind::Alpha : (j < 2 * n_c ? Kind::LambdaN : Kind::LambdaP), j % n_c};
+  }
+  /// Whether entry i is a variable of the form (step: the Heaviside step form).
+  bool exists(int i, bool step) const {
+    const Kind k = entry(i).first;
+    return k == Kind::Theta || (k == Kind::Lambda ? !step : step);
+  }
+  /// The problem-file name of entry i: theta_1, lambda_2, alpha_1, lambda_n_1, lambda_p_3, ...
+  std::string name(int i) const {
+    static constexpr const char* kNames[] = {"theta", "lambda", "alpha", "lambda_n", "lambda_p"};
+    const auto [k, j] = entry(i);
+    return std::string(kNames[static_cast<int>(k)]) + "_" + std::to_string(j + 1);
+  }
 };
 
 /// A global decision variable (nosnoc: v_global): model parameter `index` becomes an NLP variable
@@ -131,6 +178,12 @@ struct OcpData {
   /// boundary (and stage point with constraints_at_stages), each with the interval's control;
   /// relaxed by the MPCC method and homotopy of FESD's own complementarity constraints.
   int n_g_path_comp = 0;
+  /// Stage complementarity constraints (nosnoc: g_path_comp pairs that read the DCS algebraic
+  /// variables, its g_rk_comp): n_g_rk_comp pairs 0 <= a_i(x, u, p, y) perp b_i(x, u, p, y) >= 0
+  /// (OcpFunctions::g_rk_comp) at every RK stage point X_{n,m} of every finite element, y that
+  /// stage's theta, lambda, alpha, ... (RkAlgebraic), with the interval's control; lifted and
+  /// relaxed like the path complementarity pairs. Piecewise smooth OCPs only.
+  int n_g_rk_comp = 0;
 
   /// Free final time (nosnoc: time_optimal_problem): the time is scaled by a speed of time s > 0,
   /// dt = s dtau on the nominal horizon tau in [0, T]: the dynamics become s f(x, u, p) and the
@@ -295,27 +348,30 @@ class OcpFunctionsFor final : public OcpFunctions {
       f_.f_q_T(v, v);
     };
   }
-#define FESD_IMPLEMENT_OCP_FUNCTIONS(T)                                                     \
-  T f_q(const T* x, const T* u, const T* p) const override {                                \
-    if constexpr (requires { f_.f_q(x, u, p); })                                            \
-      return f_.f_q(x, u, p);                                                               \
-    else                                                                                    \
-      return T(0.0);                                                                        \
-  }                                                                                         \
-  T f_q_T(const T* x, const T* p) const override {                                          \
-    if constexpr (requires { f_.f_q_T(x, p); })                                             \
-      return f_.f_q_T(x, p);                                                                \
-    else                                                                                    \
-      return T(0.0);                                                                        \
-  }                                                                                         \
-  void g_path(const T* x, const T* u, const T* p, T* out) const override {                  \
-    if constexpr (requires { f_.g_path(x, u, p, out); }) f_.g_path(x, u, p, out);           \
-  }                                                                                         \
-  void g_terminal(const T* x, const T* p, T* out) const override {                          \
-    if constexpr (requires { f_.g_terminal(x, p, out); }) f_.g_terminal(x, p, out);         \
-  }                                                                                         \
-  void g_path_comp(const T* x, const T* u, const T* p, T* out) const override {             \
-    if constexpr (requires { f_.g_path_comp(x, u, p, out); }) f_.g_path_comp(x, u, p, out); \
+#define FESD_IMPLEMENT_OCP_FUNCTIONS(T)                                                       \
+  T f_q(const T* x, const T* u, const T* p) const override {                                  \
+    if constexpr (requires { f_.f_q(x, u, p); })                                              \
+      return f_.f_q(x, u, p);                                                                 \
+    else                                                                                      \
+      return T(0.0);                                                                          \
+  }                                                                                           \
+  T f_q_T(const T* x, const T* p) const override {                                            \
+    if constexpr (requires { f_.f_q_T(x, p); })                                               \
+      return f_.f_q_T(x, p);                                                                  \
+    else                                                                                      \
+      return T(0.0);                                                                          \
+  }                                                                                           \
+  void g_path(const T* x, const T* u, const T* p, T* out) const override {                    \
+    if constexpr (requires { f_.g_path(x, u, p, out); }) f_.g_path(x, u, p, out);             \
+  }                                                                                           \
+  void g_terminal(const T* x, const T* p, T* out) const override {                            \
+    if constexpr (requires { f_.g_terminal(x, p, out); }) f_.g_terminal(x, p, out);           \
+  }                                                                                           \
+  void g_path_comp(const T* x, const T* u, const T* p, T* out) const override {               \
+    if constexpr (requires { f_.g_path_comp(x, u, p, out); }) f_.g_path_comp(x, u, p, out);   \
+  }                                                                                           \
+  void g_rk_comp(const T* x, const T* u, const T* p, const T* y, T* out) const override {     \
+    if constexpr (requires { f_.g_rk_comp(x, u, p, y, out); }) f_.g_rk_comp(x, u, p, y, out); \
   }
   FESD_FOR_EACH_SCALAR(FESD_IMPLEMENT_OCP_FUNCTIONS)
 #undef FESD_IMPLEMENT_OCP_FUNCTIONS

@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
@@ -210,6 +211,15 @@ std::string describe_ocp_functions(const OcpData& ocp) {
         line(fmt::format("g_terminal[{}]", i),
              fmt::format("{} {}", e.g_terminal[i].text(),
                          bounds(ocp.lbg_terminal, ocp.ubg_terminal, static_cast<Eigen::Index>(i))));
+  }
+  // Complementarity pairs: a_1 .. a_n, then b_1 .. b_n; at the element boundaries, or (reading
+  // theta, ...) at the RK stage points.
+  for (const auto& [list, where] :
+       {std::pair{&e.g_path_comp, "boundaries"}, std::pair{&e.g_rk_comp, "RK stage points"}}) {
+    const std::size_t n = list->size() / 2;
+    for (std::size_t i = 0; i < n; ++i)
+      s += line("g_path_comp", fmt::format("0 <= {} perp {} >= 0 (at the {})", (*list)[i].text(),
+                                           (*list)[n + i].text(), where));
   }
   return s;
 }

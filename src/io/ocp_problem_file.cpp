@@ -250,10 +250,99 @@ Eigen::VectorXd append(const Eigen::VectorXd& v, double value) {
   return out;
 }
 
+/// The DCS algebraic variables of an RK stage that g_path_comp may read (RkAlgebraic), or none
+/// (`projected`: a projected model has no theta).
+struct StageSymbols {
+  RkAlgebraic layout;
+  bool projected = false;
+};
+
+/// The entry of the RkAlgebraic layout named by `name` (theta_i, lambda_i, alpha_j, lambda_n_j,
+/// lambda_p_j with a number >= 1; -1: not such a name); `range` gets the number of names of its
+/// kind (n_theta or n_c) and `kind` the kind's name.
+int stage_entry(std::string_view name, const RkAlgebraic& layout, int& range, std::string& kind) {
+  static constexpr std::array<std::string_view, 5> kKinds{"lambda_n", "lambda_p", "theta", "lambda",
+                                                          "alpha"};
+  for (std::string_view k : kKinds) {
+    if (name.size() <= k.size() + 1 || name.substr(0, k.size()) != k || name[k.size()] != '_')
+      continue;
+    const std::string_view digits = name.substr(k.size() + 1);
+    if (digits.size() > 6 || digits[0] == '0' ||
+        !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
+      return -1;
+    const int j = std::stoi(std::string(digits));
+    kind = std::string(k);
+    const bool per_region = k == "theta" || k == "lambda";
+    range = per_region ? layout.n_theta : layout.n_c;
+    if (j > range) return layout.size();  // out of range
+    const int offset = k == "theta"      ? 0
+                       : k == "lambda"   ? layout.n_theta
+                       : k == "alpha"    ? 2 * layout.n_theta
+                       : k == "lambda_n" ? 2 * layout.n_theta + layout.n_c
+                                         : 2 * layout.n_theta + 2 * layout.n_c;
+    return offset + j - 1;
+  }
+  return -1;
+}
+
+/// Fails on a name of a stage variable (stage_entry) in the expression `n` that is no model
+/// symbol, where stage variables cannot be read: outside g_path_comp (`in_comp` false), in a
+/// projected file, or beyond the model's regions / switching functions.
+void check_stage_names(const Reader& r, const toml::node& n, std::string_view path,
+                       const Symbols& sym, const StageSymbols& stage, bool in_comp) {
+  const auto* str = n.as_string();
+  if (str == nullptr) return;
+  const std::string& text = str->get();
+  const auto ident = [](char c, bool first) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_' ||
+           (!first && c >= '0' && c <= '9');
+  };
+  for (std::size_t i = 0; i < text.size();) {
+    if (!ident(text[i], true) || (i > 0 && ident(text[i - 1], false))) {
+      ++i;
+      continue;
+    }
+    std::size_t e = i;
+    while (e < text.size() && ident(text[e], false)) ++e;
+    const std::string name = text.substr(i, e - i);
+    i = e;
+    int range = 0;
+    std::string kind;
+    const int entry = stage_entry(name, stage.layout, range, kind);
+    if (entry < 0 || std::find(sym.all.begin(), sym.all.end(), name) != sym.all.end()) continue;
+    if (stage.projected)
+      r.fail(n.source(), path,
+             fmt::format("'{}': a projected model has no DCS algebraic variables (theta, lambda, "
+                         "alpha exist for piecewise smooth models only)",
+                         name));
+    if (!in_comp)
+      r.fail(n.source(), path,
+             fmt::format("'{}' is a DCS algebraic variable of the RK stages: only g_path_comp may "
+                         "read it",
+                         name));
+    if (entry >= stage.layout.size())
+      r.fail(n.source(), path,
+             fmt::format("'{}': out of range (the model has {} {}: {}_1 .. {}_{})", name,
+                         kind == "theta" || kind == "lambda" ? "n_theta =" : "n_c =",
+                         kind == "theta" || kind == "lambda"
+                             ? count(static_cast<std::size_t>(range), "region")
+                             : count(static_cast<std::size_t>(range), "switching function"),
+                         kind, kind, range));
+  }
+}
+
 /// The expressions of [ocp]: f_q, f_q_T, g_path, g_terminal (f_q_T and g_terminal without
-/// controls).
-OcpExpressions read_ocp_expressions(const Reader& r, const toml::table& t, const Symbols& sym) {
+/// controls), g_path_comp (its pairs that read stage variables become g_rk_comp).
+OcpExpressions read_ocp_expressions(const Reader& r, const toml::table& t, const Symbols& sym,
+                                    const StageSymbols& stage) {
   OcpExpressions e;
+  for (std::string_view key : {"f_q", "f_q_T"})
+    if (const toml::node* n = t.get(key))
+      check_stage_names(r, *n, join("ocp", key), sym, stage, false);
+  for (std::string_view key : {"g_path", "g_terminal"})
+    if (const toml::node* n = t.get(key); n != nullptr && n->as_array() != nullptr)
+      for (std::size_t i = 0; i < n->as_array()->size(); ++i)
+        check_stage_names(r, (*n->as_array())[i], index(join("ocp", key), i), sym, stage, false);
   if (const toml::node* n = t.get("f_q")) e.f_q = r.expression(*n, "ocp.f_q", sym.all);
   if (const toml::node* n = t.get("f_q_T")) {
     e.f_q_T = r.expression(*n, "ocp.f_q_T", sym.all);
@@ -271,7 +360,17 @@ OcpExpressions read_ocp_expressions(const Reader& r, const toml::table& t, const
     const toml::array& pairs = r.array(*n, path, "an array of pairs [a, b] of expressions");
     if (pairs.empty())
       r.fail(n->source(), path, "empty (expected at least one pair [a, b] of expressions)");
-    std::vector<expr::Expression> a, b;
+    // The symbols and then the stage variables y (a name the model uses stays the model's: its
+    // stage slot gets a name no expression can spell).
+    std::vector<std::string> symbols = sym.all;
+    const int n_rk = stage.projected ? 0 : stage.layout.size();
+    for (int i = 0; i < n_rk; ++i) {
+      const std::string name = stage.layout.name(i);
+      const bool taken = std::find(sym.all.begin(), sym.all.end(), name) != sym.all.end();
+      symbols.push_back(taken ? "#" + name : name);
+    }
+    const int first_y = static_cast<int>(sym.all.size());
+    std::vector<expr::Expression> a, b, a_rk, b_rk;
     for (std::size_t i = 0; i < pairs.size(); ++i) {
       const std::string pi = index(path, i);
       const toml::array& pair = r.array(pairs[i], pi, "a pair [a, b] of expressions");
@@ -279,11 +378,22 @@ OcpExpressions read_ocp_expressions(const Reader& r, const toml::table& t, const
         r.fail(pairs[i].source(), pi,
                fmt::format("{} expressions (expected a pair [a, b]: 0 <= a perp b >= 0)",
                            pair.size()));
-      a.push_back(r.expression(pair[0], index(pi, 0), sym.all));
-      b.push_back(r.expression(pair[1], index(pi, 1), sym.all));
+      for (std::size_t s = 0; s < 2; ++s)
+        check_stage_names(r, pair[s], index(pi, s), sym, stage, true);
+      expr::Expression ea = r.expression(pair[0], index(pi, 0), symbols);
+      expr::Expression eb = r.expression(pair[1], index(pi, 1), symbols);
+      const auto reads_y = [&](const expr::Expression& x) {
+        return !x.dependencies().empty() && x.dependencies().back() >= first_y;
+      };
+      const bool rk = reads_y(ea) || reads_y(eb);
+      (rk ? a_rk : a).push_back(std::move(ea));
+      (rk ? b_rk : b).push_back(std::move(eb));
     }
     e.g_path_comp = std::move(a);
     e.g_path_comp.insert(e.g_path_comp.end(), b.begin(), b.end());
+    e.g_rk_comp = std::move(a_rk);
+    e.g_rk_comp.insert(e.g_rk_comp.end(), b_rk.begin(), b_rk.end());
+    if (!e.g_rk_comp.empty()) e.n_rk = n_rk;
   }
 
   return e;
@@ -368,14 +478,19 @@ OcpProblem parse_ocp_problem(std::string_view toml_text, std::string_view source
            "a free initial state)");
   check_table_keys(r, t, registry::Table::Ocp, kKind);
   check_required_key(r, t, registry::Table::Ocp);
-  OcpExpressions e = read_ocp_expressions(r, t, sym);
+  int n_theta = 0, n_c = 0;  // the stage variables g_path_comp may read
+  for (const RawSubsystem& sub : spec.subsystems) {
+    n_theta += sub.n_f;
+    n_c += static_cast<int>(sub.expressions.c.size());
+  }
+  OcpExpressions e = read_ocp_expressions(r, t, sym, {{n_theta, n_c}, false});
   const auto reads_time = [&](const expr::Expression& x) {
     return sym.time_index >= 0 && x.depends_on(sym.time_index);
   };
   bool has_clock = spec.uses_time();
   if (e.f_q) has_clock = has_clock || reads_time(*e.f_q);
   if (e.f_q_T) has_clock = has_clock || reads_time(*e.f_q_T);
-  for (const auto* list : {&e.g_path, &e.g_terminal, &e.g_path_comp})
+  for (const auto* list : {&e.g_path, &e.g_terminal, &e.g_path_comp, &e.g_rk_comp})
     has_clock = has_clock || std::any_of(list->begin(), list->end(), reads_time);
 
   // [model] x0 and the Pss; the OCP starts at t = 0.
@@ -394,6 +509,7 @@ OcpProblem parse_ocp_problem(std::string_view toml_text, std::string_view source
   ocp.n_g_path = static_cast<int>(e.g_path.size());
   ocp.n_g_terminal = static_cast<int>(e.g_terminal.size());
   ocp.n_g_path_comp = static_cast<int>(e.g_path_comp.size()) / 2;
+  ocp.n_g_rk_comp = static_cast<int>(e.g_rk_comp.size()) / 2;
   // Its layout checks are invariants of this reader (fesd::InternalError), not input errors.
   ocp.functions = std::make_shared<const ExpressionOcpFunctions>(layout, std::move(e));
 
@@ -425,7 +541,7 @@ PdsOcpProblem parse_pds_ocp_problem(std::string_view toml_text, std::string_view
     r.fail(x0->source(), "ocp.x0", "x0 belongs in [model] (the initial state)");
   check_table_keys(r, t, registry::Table::Ocp, kKind);
   check_required_key(r, t, registry::Table::Ocp);
-  OcpExpressions e = read_ocp_expressions(r, t, m.sym);
+  OcpExpressions e = read_ocp_expressions(r, t, m.sym, {{}, /*projected=*/true});
   const auto reads_time = [&](const expr::Expression& x) { return x.depends_on(m.sym.time_index); };
   bool uses_time = (e.f_q && reads_time(*e.f_q)) || (e.f_q_T && reads_time(*e.f_q_T));
   for (const auto* list : {&e.g_path, &e.g_terminal, &e.g_path_comp})

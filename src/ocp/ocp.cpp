@@ -123,6 +123,7 @@ std::unique_ptr<OcpNlp> build(const Ocp& ocp, const OcpOptions& o, const StagePa
 
   ocp_detail::add_ocp_terms(mp, ocp, o, b->tab, n_x, n_u, b->s0, b->p_k, b->q, b->iv,
                             b->terminal_slacks, b->comp_points);
+  ocp_detail::add_rk_comp(*b, ocp, ocp_detail::rk_algebraic(m), d.dcs_mode == DcsMode::Step, n_x);
   std::vector<int> clock_end;  // time freezing: the clock at every control interval's end
   if (ocp.time_freezing)
     for (const auto& iv : b->iv) clock_end.push_back(iv->x(iv->N_FE(), ocp.clock_state));
@@ -614,6 +615,35 @@ std::vector<std::string> block_size_errors(const Ocp& ocp, const OcpOptions& o) 
   const Pss& m = ocp.model;
   for (std::string& e : cost_block_size_errors(ocp, m.n_x(), m.n_u(), m.n_p(), d.n_s))
     errors.push_back(std::move(e));
+  if (ocp.n_g_rk_comp > 0 && ocp.functions) {
+    const RkAlgebraic layout = rk_algebraic(m);
+    const bool step = d.dcs_mode == DcsMode::Step;
+    // Entries the form lacks: every one the functions name (an empty list means "all").
+    for (int i : ocp.functions->g_rk_comp_inputs())
+      if (i < 0 || i >= layout.size())
+        errors.push_back(fmt::format(
+            "ocp.g_path_comp: reads stage entry {}, out of range (the RK stage variables of this "
+            "model are {} entries: theta_1 .. theta_{}, lambda, alpha, lambda_n, lambda_p)",
+            i, layout.size(), layout.n_theta));
+      else if (!layout.exists(i, step))
+        errors.push_back(fmt::format(
+            "ocp.g_path_comp: reads {}, which the {} form does not have (Stewart's form: theta_i, "
+            "lambda_i; the step form (dcs_mode = step): theta_i, alpha_j, lambda_n_j, lambda_p_j)",
+            layout.name(i), step ? "step" : "Stewart"));
+    const RkCompEq block{ocp.functions.get(),
+                         m.n_x(),
+                         m.n_u(),
+                         m.n_p() + (has_speed_of_time(ocp) ? 1 : 0),
+                         ocp.n_g_rk_comp,
+                         layout.size(),
+                         rk_comp_entries(*ocp.functions, layout, step)};
+    if (block.num_inputs() > ad::kMaxInputs)
+      errors.push_back(fmt::format(
+          "ocp.g_path_comp = {} pairs at the RK stages: one block of n_x + n_u + n_p + (stage "
+          "variables read) + 2 n = {} inputs per stage point; at most {} inputs per block are "
+          "supported (use fewer pairs or stage variables)",
+          ocp.n_g_rk_comp, block.num_inputs(), ad::kMaxInputs));
+  }
   return errors;
 }
 

@@ -193,6 +193,11 @@ void check_data(std::vector<std::string>& e, const OcpData& ocp, const ModelSize
     e.push_back(
         "ocp.functions: none, but path complementarity pairs are declared (n_g_path_comp "
         "> 0)");
+  if (ocp.n_g_rk_comp < 0)
+    e.push_back(fmt::format("ocp.n_g_rk_comp = {}: must be >= 0", ocp.n_g_rk_comp));
+  if (ocp.n_g_rk_comp > 0 && !ocp.functions)
+    e.push_back(
+        "ocp.functions: none, but stage complementarity pairs are declared (n_g_rk_comp > 0)");
   if (ocp.n_g_path < 0) e.push_back(fmt::format("ocp.n_g_path = {}: must be >= 0", ocp.n_g_path));
   if (ocp.n_g_terminal < 0)
     e.push_back(fmt::format("ocp.n_g_terminal = {}: must be >= 0", ocp.n_g_terminal));
@@ -313,7 +318,9 @@ OcpInputErrors check_input(const PdsOcp& ocp, const OcpOptions& options) {
                         "initialization = external (x_guess)"},
               std::pair{ocp.time_optimal_problem, "time_optimal_problem"},
               std::pair{ocp.time_freezing, "time_freezing"},
-              std::pair{ocp.n_g_path_comp > 0, "g_path_comp (path complementarity)"}})
+              std::pair{ocp.n_g_path_comp > 0, "g_path_comp (path complementarity)"},
+              std::pair{ocp.n_g_rk_comp > 0,
+                        "g_path_comp reading theta (stage complementarity, n_g_rk_comp)"}})
           if (given)
             e.options.push_back(fmt::format("ocp.{}: not supported for projected models yet", key));
         if (!ocp.N_FE.empty() && d.use_fesd)

@@ -119,6 +119,47 @@ struct PathCompEq {
   }
 };
 
+/// The stage complementarity functions at one RK stage point with their lifted variables A, B >= 0:
+/// outputs a(x, q, p, y) - A and b(x, q, p, y) - B (= 0), y the stage's DCS algebraic variables
+/// (RkAlgebraic, `y_size` entries) of which the block reads `entries` (the others are 0).
+/// inputs: x (n_x), q (n_u), p (n_p), y[entries] (entries.size()), A (n), B (n)
+struct RkCompEq {
+  const OcpFunctions* f;
+  int n_x, n_u, n_p, n, y_size;
+  std::vector<int> entries;
+  int num_inputs() const { return n_x + n_u + n_p + static_cast<int>(entries.size()) + 2 * n; }
+  int num_outputs() const { return 2 * n; }
+  template <class T>
+  void operator()(const T* w, T* c) const {
+    thread_local std::vector<T> y;
+    y.assign(static_cast<std::size_t>(y_size), T(0.0));
+    const T* ye = w + n_x + n_u + n_p;
+    for (std::size_t l = 0; l < entries.size(); ++l)
+      y[static_cast<std::size_t>(entries[l])] = ye[l];
+    f->g_rk_comp(w, w + n_x, w + n_x + n_u, y.data(), c);
+    const T* lifted = ye + entries.size();
+    for (int i = 0; i < 2 * n; ++i) c[i] = c[i] - lifted[i];
+  }
+};
+
+/// The stage variable layout of a piecewise smooth model: its regions and switching functions.
+inline RkAlgebraic rk_algebraic(const Pss& m) {
+  return {m.n_theta(), m.n_c()};
+}
+
+/// The entries of the RkAlgebraic layout the stage complementarity pairs read: those
+/// OcpFunctions::g_rk_comp_inputs() names, or (empty) every entry of the form (step: the Heaviside
+/// step form). Entries the form lacks are left out (check_input reports them).
+inline std::vector<int> rk_comp_entries(const OcpFunctions& f, const RkAlgebraic& layout,
+                                        bool step) {
+  std::vector<int> out;
+  std::vector<int> named = f.g_rk_comp_inputs();
+  if (named.empty()) named = range(0, layout.size());
+  for (int i : named)
+    if (i >= 0 && i < layout.size() && layout.exists(i, step)) out.push_back(i);
+  return out;
+}
+
 /// The messages of the cost and constraint blocks with more than ad::kMaxInputs inputs (each
 /// starts with the problem-file key to change).
 std::vector<std::string> cost_block_size_errors(const OcpData& ocp, int n_x, int n_u, int n_p,
@@ -157,10 +198,16 @@ struct OcpNlpParts {
   std::vector<int> terminal_slacks;
   /// Path complementarity points: the inputs x, q, p of PathCompEq and the first of its lifted
   /// variables (A then B, 2 n_g_path_comp).
+  /// Stage complementarity points (OcpData::n_g_rk_comp) also have `y`: the NLP variables of the
+  /// entries of the RkAlgebraic layout they read (rk_entries).
   struct CompPoint {
     std::vector<int> inputs;
     int lifted = -1;
+    bool rk = false;
+    std::vector<int> y;
   };
+  std::vector<int> rk_entries;
+  RkAlgebraic rk_layout;
   std::vector<CompPoint> comp_points;
 };
 
@@ -337,7 +384,7 @@ void add_ocp_terms(mpcc::Problem& mp, const OcpData& ocp, const OcpOptions& o, c
     // 0 <= A perp B >= 0 with A = a(x, q, p), B = b(x, q, p): lifted, so that the relaxation
     // sees products of variables with sign bounds as FESD's own pairs.
     const int lifted = nlp.add_variables(2 * n_comp, 0.0, nlp::kInf, 0.0);
-    comp_points.push_back({vars, lifted});
+    comp_points.push_back({vars, lifted, false, {}});
     for (int i = 0; i < 2 * n_comp; ++i) vars.push_back(lifted + i);
     nlp.add_constraint(comp, vars, std::vector<double>(2 * n_comp, 0.0),
                        std::vector<double>(2 * n_comp, 0.0));
@@ -400,6 +447,69 @@ void add_ocp_terms(mpcc::Problem& mp, const OcpData& ocp, const OcpOptions& o, c
       nlp.add_objective(nlp::make_block(nlp::Sum{n_g}), terminal_slacks, ocp.rho_terminal);
     }
   }
+}
+
+/// The stage complementarity pairs (OcpData::n_g_rk_comp): at every RK stage point X_{n,m} of every
+/// element of every control interval, a(X_{n,m}, q_k, p_k, y_{n,m}) and b(...) lifted into
+/// variables A, B >= 0 (as the path complementarity pairs), y_{n,m} the stage's theta, lambda,
+/// alpha, lambda_n, lambda_p (RkAlgebraic; `step`: the Heaviside step form). For FesdInterval.
+template <class Parts>
+void add_rk_comp(Parts& b, const OcpData& ocp, const RkAlgebraic& layout, bool step, int n_x) {
+  const int n_comp = ocp.n_g_rk_comp;
+  if (n_comp <= 0) return;
+  mpcc::Problem& mp = b.mpcc;
+  nlp::BlockNlp& nlp = mp.nlp();
+  const OcpFunctions* f = ocp.functions.get();
+  const int n_u = static_cast<int>(b.q.front().size());
+  const int n_p = static_cast<int>(b.p_k.front().size());
+  b.rk_layout = layout;
+  b.rk_entries = rk_comp_entries(*f, layout, step);
+  auto block = nlp::make_block(RkCompEq{f, n_x, n_u, n_p, n_comp, layout.size(), b.rk_entries});
+  std::vector<discretization::CompGroup> groups;
+  std::vector<discretization::CompPair> pairs;
+  for (std::size_t k = 0; k < b.iv.size(); ++k) {
+    const auto& v = *b.iv[k];
+    for (int n = 0; n < v.N_FE(); ++n)
+      for (int m = 0; m < v.n_s(); ++m) {
+        std::vector<int> vars = range(v.X(n, m, 0), n_x);
+        vars.insert(vars.end(), b.q[k].begin(), b.q[k].end());
+        vars.insert(vars.end(), b.p_k[k].begin(), b.p_k[k].end());
+        const std::vector<int> xqp = vars;
+        std::vector<int> y;
+        for (int i : b.rk_entries) {
+          const auto [kind, j] = layout.entry(i);
+          switch (kind) {
+            case RkAlgebraic::Kind::Theta:
+              y.push_back(v.theta(n, m, j));
+              break;
+            case RkAlgebraic::Kind::Lambda:
+              y.push_back(v.lambda(n, m, j));
+              break;
+            case RkAlgebraic::Kind::Alpha:
+              y.push_back(v.alpha(n, m, j));
+              break;
+            case RkAlgebraic::Kind::LambdaN:
+              y.push_back(v.lambda(n, m, j));
+              break;
+            case RkAlgebraic::Kind::LambdaP:
+              y.push_back(v.lambda(n, m, layout.n_c + j));
+              break;
+          }
+        }
+        vars.insert(vars.end(), y.begin(), y.end());
+        const int lifted = nlp.add_variables(2 * n_comp, 0.0, nlp::kInf, 0.0);
+        for (int i = 0; i < 2 * n_comp; ++i) vars.push_back(lifted + i);
+        nlp.add_constraint(block, vars, std::vector<double>(2 * n_comp, 0.0),
+                           std::vector<double>(2 * n_comp, 0.0));
+        b.comp_points.push_back({xqp, lifted, true, std::move(y)});
+        for (int i = 0; i < n_comp; ++i) {
+          const discretization::CompPair pair{lifted + i, lifted + n_comp + i};
+          groups.push_back({{pair}, false});
+          pairs.push_back(pair);
+        }
+      }
+  }
+  mp.add_complementarity(groups, pairs);
 }
 
 /// The OCP's own cost at a solution: the Lagrange term with the RK quadrature of each element
@@ -488,13 +598,20 @@ void extract_result(const OcpData& ocp, const Tableau& tab, int n_x, int n_u,
 /// guess of their inputs, clamped to >= 0. After the guess of everything else.
 template <class Parts>
 void guess_path_comp(Parts& b, const OcpData& ocp, int n_x, int n_u) {
-  const int n = ocp.n_g_path_comp;
   std::vector<double>& w = b.mpcc.guess();
-  std::vector<double> out(static_cast<std::size_t>(2 * n));
   for (const auto& point : b.comp_points) {
+    const int n = point.rk ? ocp.n_g_rk_comp : ocp.n_g_path_comp;
+    std::vector<double> out(static_cast<std::size_t>(2 * n));
     std::vector<double> in;
     for (int v : point.inputs) in.push_back(w[v]);
-    ocp.functions->g_path_comp(in.data(), in.data() + n_x, in.data() + n_x + n_u, out.data());
+    if (point.rk) {
+      std::vector<double> y(static_cast<std::size_t>(b.rk_layout.size()), 0.0);
+      for (std::size_t l = 0; l < point.y.size(); ++l) y[b.rk_entries[l]] = w[point.y[l]];
+      ocp.functions->g_rk_comp(in.data(), in.data() + n_x, in.data() + n_x + n_u, y.data(),
+                               out.data());
+    } else {
+      ocp.functions->g_path_comp(in.data(), in.data() + n_x, in.data() + n_x + n_u, out.data());
+    }
     for (int i = 0; i < 2 * n; ++i)
       w[point.lifted + i] = std::isfinite(out[i]) ? std::max(out[i], 0.0) : 0.0;
   }

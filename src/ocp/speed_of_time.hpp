@@ -16,6 +16,7 @@
 #pragma once
 #include <memory>
 #include <utility>
+#include <vector>
 
 #include <Eigen/Dense>
 
@@ -61,29 +62,36 @@ class SpeedOfTimeCosts final : public OcpFunctions {
       : f_(std::move(f)), n_p_(n_p), add_one_(add_one), weight_(rho_sot / T_s) {}
   bool has_f_q() const override { return add_one_ || weight_ > 0 || (f_ && f_->has_f_q()); }
   bool has_f_q_T() const override { return f_ && f_->has_f_q_T(); }
-#define FESD_SPEED_OF_TIME_COSTS(T)                                             \
-  T f_q(const T* x, const T* u, const T* p) const override {                    \
-    const T& s = p[n_p_];                                                       \
-    T q(add_one_ ? 1.0 : 0.0);                                                  \
-    if (f_ && f_->has_f_q()) q = q + f_->f_q(x, u, p);                          \
-    T out = s * q;                                                              \
-    if (weight_ > 0) out = out + weight_ * (s - 1.0) * (s - 1.0);               \
-    return out;                                                                 \
-  }                                                                             \
-  T f_q_T(const T* x, const T* p) const override {                              \
-    return f_ ? f_->f_q_T(x, p) : T(0.0);                                       \
-  }                                                                             \
-  void g_path(const T* x, const T* u, const T* p, T* out) const override {      \
-    if (f_) f_->g_path(x, u, p, out);                                           \
-  }                                                                             \
-  void g_terminal(const T* x, const T* p, T* out) const override {              \
-    if (f_) f_->g_terminal(x, p, out);                                          \
-  }                                                                             \
-  void g_path_comp(const T* x, const T* u, const T* p, T* out) const override { \
-    if (f_) f_->g_path_comp(x, u, p, out);                                      \
+#define FESD_SPEED_OF_TIME_COSTS(T)                                                       \
+  T f_q(const T* x, const T* u, const T* p) const override {                              \
+    const T& s = p[n_p_];                                                                 \
+    T q(add_one_ ? 1.0 : 0.0);                                                            \
+    if (f_ && f_->has_f_q()) q = q + f_->f_q(x, u, p);                                    \
+    T out = s * q;                                                                        \
+    if (weight_ > 0) out = out + weight_ * (s - 1.0) * (s - 1.0);                         \
+    return out;                                                                           \
+  }                                                                                       \
+  T f_q_T(const T* x, const T* p) const override {                                        \
+    return f_ ? f_->f_q_T(x, p) : T(0.0);                                                 \
+  }                                                                                       \
+  void g_path(const T* x, const T* u, const T* p, T* out) const override {                \
+    if (f_) f_->g_path(x, u, p, out);                                                     \
+  }                                                                                       \
+  void g_terminal(const T* x, const T* p, T* out) const override {                        \
+    if (f_) f_->g_terminal(x, p, out);                                                    \
+  }                                                                                       \
+  void g_path_comp(const T* x, const T* u, const T* p, T* out) const override {           \
+    if (f_) f_->g_path_comp(x, u, p, out);                                                \
+  }                                                                                       \
+  void g_rk_comp(const T* x, const T* u, const T* p, const T* y, T* out) const override { \
+    if (f_) f_->g_rk_comp(x, u, p, y, out);                                               \
   }
   FESD_FOR_EACH_SCALAR(FESD_SPEED_OF_TIME_COSTS)
 #undef FESD_SPEED_OF_TIME_COSTS
+  std::vector<int> g_rk_comp_inputs() const override {
+    return f_ ? f_->g_rk_comp_inputs() : std::vector<int>{};
+  }
+
  private:
   std::shared_ptr<const OcpFunctions> f_;
   int n_p_;
