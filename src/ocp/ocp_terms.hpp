@@ -482,14 +482,12 @@ void add_rk_comp(Parts& b, const OcpData& ocp, const RkAlgebraic& layout, bool s
             case RkAlgebraic::Kind::Theta:
               y.push_back(v.theta(n, m, j));
               break;
-            case RkAlgebraic::Kind::Lambda:
+            case RkAlgebraic::Kind::Lambda:   // Stewart's lambda
+            case RkAlgebraic::Kind::LambdaN:  // the step form's lambda_n: its first n_c
               y.push_back(v.lambda(n, m, j));
               break;
             case RkAlgebraic::Kind::Alpha:
               y.push_back(v.alpha(n, m, j));
-              break;
-            case RkAlgebraic::Kind::LambdaN:
-              y.push_back(v.lambda(n, m, j));
               break;
             case RkAlgebraic::Kind::LambdaP:
               y.push_back(v.lambda(n, m, layout.n_c + j));
