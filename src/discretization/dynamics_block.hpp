@@ -19,28 +19,24 @@
 #include <vector>
 
 #include "dcs/stewart.hpp"
+#include "discretization/dynamics_eq.hpp"
 #include "fesd/model.hpp"
 #include "nlp/block.hpp"
 
 namespace fesd::discretization {
 
-/// V - sum_r f_r(X, q, p) theta_r = 0.  inputs: V (n_x), X (n_x), theta (n_theta), q, p
-struct DynamicsEq {
+/// sum_r theta_r f_r(X, q, p), the right-hand side of (25): y = theta (n_theta).
+struct StewartRhs {
   const Pss* m;
-  int num_inputs() const { return 2 * m->n_x() + m->n_theta() + m->n_u() + m->n_p(); }
-  int num_outputs() const { return m->n_x(); }
+  int n_y() const { return m->n_theta(); }
   template <class T>
-  void operator()(const T* w, T* c) const {
-    const int n_x = m->n_x();
-    const T* V = w;
-    const T* X = w + n_x;
-    const T* theta = X + n_x;
-    const T* q = theta + m->n_theta();
-    const T* p = q + m->n_u();
-    dcs::eval_F_theta(*m, X, q, p, theta, c);
-    for (int i = 0; i < n_x; ++i) c[i] = V[i] - c[i];
+  void operator()(const T* X, const T* theta, const T* q, const T* p, T* out) const {
+    dcs::eval_F_theta(*m, X, q, p, theta, out);
   }
 };
+
+/// V - sum_r f_r(X, q, p) theta_r = 0.  inputs: V (n_x), X (n_x), theta (n_theta), q, p
+using DynamicsEq = StageDynamicsEq<StewartRhs>;
 
 /// f_r(z) of one region r, z = (X (n_x), q (n_u), p (n_p)).
 struct RegionField {

@@ -10,6 +10,7 @@
 
 #include "dcs/step.hpp"
 #include "discretization/dynamics_block.hpp"
+#include "discretization/dynamics_eq.hpp"
 #include "discretization/stage_state_block.hpp"
 #include "discretization/step_equilibration_block.hpp"
 #include "fesd/ad.hpp"
@@ -112,24 +113,20 @@ struct StepThetaEq {
   }
 };
 
-/// The step form's dynamics of a general inclusion (PssFunctions::f_alpha): V - f_alpha(X, alpha,
-/// q, p) = 0.  inputs: V (n_x), X (n_x), alpha (n_c), q (n_u), p (n_p)
-struct AlphaDynamicsEq {
+/// The step form's general inclusion f_alpha(X, alpha, q, p) (PssFunctions::f_alpha): y = alpha
+/// (n_c).
+struct AlphaRhs {
   const Pss* m;
-  int num_inputs() const { return 2 * m->n_x() + m->n_c() + m->n_u() + m->n_p(); }
-  int num_outputs() const { return m->n_x(); }
+  int n_y() const { return m->n_c(); }
   template <class T>
-  void operator()(const T* w, T* c) const {
-    const int n_x = m->n_x();
-    const T* V = w;
-    const T* X = w + n_x;
-    const T* alpha = X + n_x;
-    const T* q = alpha + m->n_c();
-    const T* p = q + m->n_u();
-    m->functions().f_alpha(X, alpha, q, p, c);
-    for (int i = 0; i < n_x; ++i) c[i] = V[i] - c[i];
+  void operator()(const T* X, const T* alpha, const T* q, const T* p, T* out) const {
+    m->functions().f_alpha(X, alpha, q, p, out);
   }
 };
+
+/// The step form's dynamics of a general inclusion: V - f_alpha(X, alpha, q, p) = 0.
+/// inputs: V (n_x), X (n_x), alpha (n_c), q (n_u), p (n_p)
+using AlphaDynamicsEq = StageDynamicsEq<AlphaRhs>;
 
 /// alpha_j + beta_j = 1 (beta = 1 - alpha as a variable).  inputs: alpha (n_c), beta (n_c)
 struct AlphaBetaEq {

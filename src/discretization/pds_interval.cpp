@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "core/option_registry.hpp"
+#include "discretization/dynamics_eq.hpp"
 #include "discretization/stage_state_block.hpp"
 #include "fesd/error.hpp"
 #include "nlp/block.hpp"
@@ -18,25 +19,22 @@ namespace {
 
 using nlp::kInf;
 
-/// V - f(X, q, p) - grad c(X, p) lambda = 0 (6a).  inputs: V (n_x), X (n_x), lambda (n_c), q, p
-struct PdsDynamicsEq {
+/// f(X, q, p) + grad c(X, p) lambda, the right-hand side of (6a): y = lambda (n_c).
+struct PdsRhs {
   const Pds* m;
-  int num_inputs() const { return 2 * m->n_x() + m->n_c() + m->n_u() + m->n_p(); }
-  int num_outputs() const { return m->n_x(); }
+  int n_y() const { return m->n_c(); }
   template <class T>
-  void operator()(const T* w, T* c) const {
-    const int n_x = m->n_x();
-    const T* V = w;
-    const T* X = w + n_x;
-    const T* lambda = X + n_x;
-    const T* q = lambda + m->n_c();
-    const T* p = q + m->n_u();
-    std::vector<T> g(static_cast<std::size_t>(n_x));
-    m->functions().f(X, q, p, c);
-    m->functions().grad_c_lambda(X, p, lambda, g.data());
-    for (int i = 0; i < n_x; ++i) c[i] = V[i] - c[i] - g[i];
+  void operator()(const T* X, const T* /*lambda*/, const T* q, const T* p, T* out) const {
+    m->functions().f(X, q, p, out);
+  }
+  template <class T>
+  void second(const T* X, const T* lambda, const T* /*q*/, const T* p, T* out) const {
+    m->functions().grad_c_lambda(X, p, lambda, out);
   }
 };
+
+/// V - f(X, q, p) - grad c(X, p) lambda = 0 (6a).  inputs: V (n_x), X (n_x), lambda (n_c), q, p
+using PdsDynamicsEq = StageDynamicsEq<PdsRhs>;
 
 /// C - c(X, p) = 0 (the lifted constraint values of (6b)).  inputs: C (n_c), X (n_x), p
 struct ConstraintEq {
