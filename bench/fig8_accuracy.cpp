@@ -43,6 +43,7 @@
 
 #include "bench_args.hpp"
 #include "oscillator_model.hpp"
+#include "slope_fit.hpp"
 
 namespace {
 
@@ -133,38 +134,14 @@ struct Run {
   bool ok() const { return status == fesd::Status::Success; }
 };
 
-struct Fit {
-  std::optional<double> slope;
-  int points = 0;
-  std::vector<double> local;  // slopes between consecutive points of the window
-};
-
-/// Least-squares slope of log y against log h through the points with kFitLow < y < high.
-Fit fit_slope(const std::vector<std::pair<double, double>>& h_y, double high) {
+/// The least-squares slope (slope_fit.hpp) of log y against log h through the points with
+/// kFitLow < y < high, h decreasing (the order of the table: the local slopes go along it).
+fesd_bench::SlopeFit fit_slope(const std::vector<std::pair<double, double>>& h_y, double high) {
   std::vector<std::pair<double, double>> pts;
   for (const auto& [h, y] : h_y)
-    if (std::isfinite(y) && y > kFitLow && y < high) pts.emplace_back(std::log(h), std::log(y));
+    if (std::isfinite(y) && y > kFitLow && y < high) pts.emplace_back(h, y);
   std::sort(pts.begin(), pts.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
-  Fit f;  // local slopes in the order of the table: N_sim increasing, h decreasing
-  f.points = static_cast<int>(pts.size());
-  for (std::size_t i = 1; i < pts.size(); ++i)
-    f.local.push_back((pts[i].second - pts[i - 1].second) / (pts[i].first - pts[i - 1].first));
-  if (pts.size() < 2) return f;
-  double mx = 0, my = 0;
-  for (const auto& [x, y] : pts) {
-    mx += x;
-    my += y;
-  }
-  const double n = static_cast<double>(pts.size());
-  mx /= n;
-  my /= n;
-  double sxy = 0, sxx = 0;
-  for (const auto& [x, y] : pts) {
-    sxy += (x - mx) * (y - my);
-    sxx += (x - mx) * (x - mx);
-  }
-  f.slope = sxy / sxx;
-  return f;
+  return fesd_bench::fit_log_log(pts);
 }
 
 std::string fmt_opt(const std::optional<double>& v, const char* spec = "{:.2f}") {
@@ -415,7 +392,7 @@ int main(int argc, char** argv) {
              "std", "FESD", "FESD-ord", "t_s FESD", "t_s std", "FESD local slopes", "wall s");
   for (std::size_t mi = 0; mi < cfg.methods.size(); ++mi) {
     const Method& m = cfg.methods[mi];
-    std::optional<Fit> fx[2], ft[2];
+    std::optional<fesd_bench::SlopeFit> fx[2], ft[2];
     double wall = 0;
     int failures = 0;
     for (std::size_t k = 0; k < modes.size(); ++k) {
@@ -434,12 +411,12 @@ int main(int argc, char** argv) {
       fx[modes[k] ? 1 : 0] = fit_slope(ex, high);
       ft[modes[k] ? 1 : 0] = fit_slope(et, high);
     }
-    auto slope = [](const std::optional<Fit>& f) {
-      if (!f || !f->slope) return std::string("-");
-      return fmt::format("{:.2f} ({})", *f->slope, f->points);
+    auto slope = [](const std::optional<fesd_bench::SlopeFit>& f) {
+      if (!f || f->points < 2) return std::string("-");
+      return fmt::format("{:.2f} ({})", f->slope, f->points);
     };
     std::optional<double> diff;
-    if (fx[1] && fx[1]->slope) diff = *fx[1]->slope - m.order;
+    if (fx[1] && fx[1]->points >= 2) diff = fx[1]->slope - m.order;
     std::string local;
     if (fx[1])
       for (double s : fx[1]->local) local += fmt::format("{}{:.1f}", local.empty() ? "" : " ", s);
@@ -448,10 +425,10 @@ int main(int argc, char** argv) {
         slope(fx[0]), slope(fx[1]), fmt_opt(diff, "{:+.2f}"), slope(ft[1]), slope(ft[0]),
         local.empty() ? "-" : local, wall,
         failures ? fmt::format("  ({} failed run{})", failures, failures == 1 ? "" : "s") : "");
-    auto jfit = [](const std::optional<Fit>& f) -> nlohmann::json {
+    auto jfit = [](const std::optional<fesd_bench::SlopeFit>& f) -> nlohmann::json {
       if (!f) return nullptr;
       nlohmann::json j;
-      j["slope"] = f->slope ? nlohmann::json(*f->slope) : nlohmann::json(nullptr);
+      j["slope"] = f->points >= 2 ? nlohmann::json(f->slope) : nlohmann::json(nullptr);
       j["points"] = f->points;
       j["local_slopes"] = f->local;
       return j;

@@ -23,7 +23,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -37,6 +36,7 @@
 
 #include "bench_args.hpp"
 #include "gene_network_exact.hpp"
+#include "slope_fit.hpp"
 
 namespace {
 
@@ -170,27 +170,14 @@ Run run_one(const fesd::SimulationProblem& file, const Method& m, bool use_fesd,
   return r;
 }
 
-/// Least-squares slope of log E against log h through the points with E > low, h <= h_max.
-std::optional<double> fit_slope(const std::vector<std::pair<double, double>>& h_e, double low,
-                                double h_max, int& points) {
+/// The least-squares slope (slope_fit.hpp) of log E against log h through the points with
+/// E > low, h <= h_max.
+fesd_bench::SlopeFit fit_slope(const std::vector<std::pair<double, double>>& h_e, double low,
+                               double h_max) {
   std::vector<std::pair<double, double>> pts;
   for (const auto& [h, e] : h_e)
-    if (std::isfinite(e) && e > low && h <= h_max) pts.emplace_back(std::log(h), std::log(e));
-  points = static_cast<int>(pts.size());
-  if (pts.size() < 2) return std::nullopt;
-  double mx = 0, my = 0;
-  for (const auto& [x, y] : pts) {
-    mx += x;
-    my += y;
-  }
-  mx /= points;
-  my /= points;
-  double sxy = 0, sxx = 0;
-  for (const auto& [x, y] : pts) {
-    sxy += (x - mx) * (y - my);
-    sxx += (x - mx) * (x - mx);
-  }
-  return sxy / sxx;
+    if (std::isfinite(e) && e > low && h <= h_max) pts.emplace_back(h, e);
+  return fesd_bench::fit_log_log(pts);
 }
 
 }  // namespace
@@ -264,9 +251,8 @@ int main(int argc, char** argv) {
       std::vector<std::pair<double, double>> h_e;
       for (std::size_t ni = 0; ni < cfg.N.size(); ++ni)
         if (runs[mi][k][ni].ok) h_e.emplace_back(cfg.T / cfg.N[ni], runs[mi][k][ni].error);
-      int points = 0;
-      const std::optional<double> s = fit_slope(h_e, cfg.fit_low, cfg.h_max, points);
-      if (s) cols[modes[k] ? 0 : 1] = fmt::format("{:.2f} ({})", *s, points);
+      const fesd_bench::SlopeFit s = fit_slope(h_e, cfg.fit_low, cfg.h_max);
+      if (s.points >= 2) cols[modes[k] ? 0 : 1] = fmt::format("{:.2f} ({})", s.slope, s.points);
     }
     fmt::print("{:<8} {:>5} {:>10} {:>10}\n", cfg.methods[mi].label, cfg.methods[mi].order, cols[0],
                cols[1]);

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "pds_example1_model.hpp"
+#include "slope_fit.hpp"
 
 namespace {
 
@@ -39,33 +40,14 @@ std::vector<int> parse_list(const char* s) {
 // slopes of the coarser and the finer half of the points (pre-asymptotic vs. asymptotic), and the
 // range.
 struct Fit {
-  double slope = NAN, se = NAN, coarse = NAN, fine = NAN;
-  int used = 0, below_floor = 0, failed = 0, count_min = 0, count_max = 0;
+  fesd_bench::SlopeFit ls;
+  int below_floor = 0, failed = 0, count_min = 0, count_max = 0;
 };
-
-double ls_slope(const std::vector<double>& x, const std::vector<double>& y, std::size_t b,
-                std::size_t e, double* se = nullptr) {
-  const double n = static_cast<double>(e - b);
-  if (e - b < 2) return NAN;
-  double sx = 0, sy = 0;
-  for (std::size_t i = b; i < e; ++i) sx += x[i], sy += y[i];
-  const double mx = sx / n, my = sy / n;
-  double sxx = 0, sxy = 0;
-  for (std::size_t i = b; i < e; ++i)
-    sxx += (x[i] - mx) * (x[i] - mx), sxy += (x[i] - mx) * (y[i] - my);
-  const double k = sxy / sxx;
-  if (se && e - b > 2) {
-    double ss = 0;
-    for (std::size_t i = b; i < e; ++i) ss += std::pow(y[i] - my - k * (x[i] - mx), 2);
-    *se = std::sqrt(ss / (n - 2) / sxx);
-  }
-  return k;
-}
 
 Fit fit(const std::vector<int>& counts, const std::vector<double>& h, const std::vector<double>& e,
         double floor) {
   Fit f;
-  std::vector<double> x, y;
+  std::vector<std::pair<double, double>> h_e;
   for (std::size_t i = 0; i < h.size(); ++i) {
     if (!std::isfinite(e[i])) {
       ++f.failed;
@@ -75,27 +57,22 @@ Fit fit(const std::vector<int>& counts, const std::vector<double>& h, const std:
       ++f.below_floor;
       continue;
     }
-    if (x.empty()) f.count_min = counts[i];
+    if (h_e.empty()) f.count_min = counts[i];
     f.count_max = counts[i];
-    x.push_back(std::log(h[i]));
-    y.push_back(std::log(e[i]));
+    h_e.emplace_back(h[i], e[i]);
   }
-  f.used = static_cast<int>(x.size());
-  f.slope = ls_slope(x, y, 0, x.size(), &f.se);
-  if (x.size() >= 6) {
-    f.coarse = ls_slope(x, y, 0, x.size() / 2);
-    f.fine = ls_slope(x, y, x.size() / 2, x.size());
-  }
+  f.ls = fesd_bench::fit_log_log(h_e, /*halves_from=*/6);
   return f;
 }
 
 void print_fit(const char* name, const Fit& f, const std::string& expected, bool per_step) {
-  std::printf("     %-8s slope %.2f +- %.2f (%s), %s %d..%d, %d points used", name, f.slope, f.se,
-              expected.c_str(), per_step ? "N_sim" : "N_FE", f.count_min, f.count_max, f.used);
+  std::printf("     %-8s slope %.2f +- %.2f (%s), %s %d..%d, %d points used", name, f.ls.slope,
+              f.ls.se, expected.c_str(), per_step ? "N_sim" : "N_FE", f.count_min, f.count_max,
+              f.ls.points);
   if (f.below_floor) std::printf(", %d below round-off", f.below_floor);
   if (f.failed) std::printf(", %d failed", f.failed);
-  if (std::isfinite(f.coarse))
-    std::printf("; coarser half %.2f, finer half %.2f", f.coarse, f.fine);
+  if (std::isfinite(f.ls.coarse))
+    std::printf("; coarser half %.2f, finer half %.2f", f.ls.coarse, f.ls.fine);
   std::printf("\n");
 }
 
