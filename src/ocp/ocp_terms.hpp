@@ -294,24 +294,17 @@ inline void add_speed_of_time_constraints(mpcc::Problem& mp, const OcpData& ocp,
                                           const std::vector<int>& clock_end) {
   const double T_k = ocp.T / ocp.N_stages;
   if (ocp.time_optimal_problem && (ocp.T_final_min > 0 || std::isfinite(ocp.T_final_max))) {
-    std::vector<int> speeds;  // distinct variables; a global speed counts N_stages times
-    std::vector<int> count;
-    for (const std::vector<int>& pk : p_k) {
-      const auto it = std::find(speeds.begin(), speeds.end(), pk.back());
-      if (it == speeds.end()) {
-        speeds.push_back(pk.back());
-        count.push_back(1);
-      } else {
-        ++count[static_cast<std::size_t>(it - speeds.begin())];
-      }
-    }
-    if (speeds.size() == 1) {  // a bound of the one speed
-      const double n = count.front() * T_k;
-      const int v = speeds.front();
+    // The speed variables are p_k[k].back(): one per control interval with local speeds, else
+    // one for all (add_start_and_parameters).
+    if (!ocp.local_speed_of_time_variable || p_k.size() == 1) {  // a bound of the one speed
+      const double n = static_cast<double>(p_k.size()) * T_k;
+      const int v = p_k.front().back();
       mp.bound(
           v, std::max(mp.lower(v), ocp.T_final_min / n),
           std::min(mp.upper(v), std::isfinite(ocp.T_final_max) ? ocp.T_final_max / n : nlp::kInf));
     } else {  // one speed per interval: sum_k s_k = T_final / T_k
+      std::vector<int> speeds;
+      for (const std::vector<int>& pk : p_k) speeds.push_back(pk.back());
       mp.nlp().add_constraint(nlp::make_block(nlp::Sum{static_cast<int>(speeds.size())}), speeds,
                               ocp.T_final_min / T_k,
                               std::isfinite(ocp.T_final_max) ? ocp.T_final_max / T_k : nlp::kInf);
