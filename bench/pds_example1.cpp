@@ -8,6 +8,8 @@
 //                [--scheme radau_iia|lobatto_iiic] [--method fesd|standard]
 //                [--M 1e6]
 //
+// An empty list skips its table: --nsim '' runs (a) only, --nfe '' (b) only.
+//
 // (Lobatto IIIC: n_s >= 2, expected order 2 n_s - 2.)
 // Prints one row per run (error, contact and leaving time errors for FESD, NLPs, IPOPT iterations,
 // wall time) and the slopes.
@@ -15,8 +17,10 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <exception>
 #include <limits>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -30,7 +34,17 @@ std::vector<int> parse_list(const char* s) {
   std::vector<int> out;
   std::stringstream ss(s);
   std::string item;
-  while (std::getline(ss, item, ',')) out.push_back(std::stoi(item));
+  while (std::getline(ss, item, ',')) {
+    std::size_t used = 0;
+    int v = 0;
+    try {
+      v = std::stoi(item, &used);
+    } catch (const std::exception&) {
+    }
+    if (used == 0 || used != item.size())
+      throw std::invalid_argument("'" + item + "' in '" + s + "' is not an integer");
+    out.push_back(v);
+  }
   return out;
 }
 
@@ -162,7 +176,7 @@ void table(const char* title, const std::vector<int>& n_s_list, const std::vecto
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int run_main(int argc, char** argv) {
   std::vector<int> n_s_list{1, 2, 3, 4}, nfe{10, 20, 40, 80, 140, 200, 400},
       nsim{5, 10, 20, 40, 70, 100, 200};
   for (int i = 1; i + 1 < argc; i += 2) {
@@ -200,9 +214,27 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
+  for (const auto* list : {&n_s_list, &nfe, &nsim})
+    for (int v : *list)
+      if (v < 1) {
+        std::fprintf(stderr,
+                     "pds_example1: --ns, --nfe and --nsim take values >= 1 (got %d; an empty "
+                     "list, e.g. --nsim '', skips that table)\n",
+                     v);
+        return 2;
+      }
   std::printf("Example 1 of papers/fesd-pds.txt, %s, error ||x(T) - (-1, 0)||\n",
               g_scheme == fesd::RkScheme::LobattoIIIC ? "Lobatto IIIC" : "Radau IIA");
   if (!nfe.empty()) table("(a) one interval [0, T], N_FE elements", n_s_list, nfe, false);
   if (!nsim.empty()) table("(b) N_sim steps of N_FE = 2 elements", n_s_list, nsim, true);
   return 0;
+}
+
+int main(int argc, char** argv) {
+  try {
+    return run_main(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "pds_example1: %s\n", e.what());
+    return 2;
+  }
 }
