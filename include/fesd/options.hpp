@@ -228,6 +228,13 @@ struct IntegratorOptions {
   /// function theorem on every step's square system, chained over the steps
   /// (IntegratorResult::sensitivities; docs/sensitivities.md).
   bool sensitivities = false;
+  /// `theta_guess` ([simulation]): the Stewart weights theta (n_theta entries in [0, 1]) guessed
+  /// at every stage point of the first step, instead of the solution of the LP (8) at x0; the
+  /// state guess follows them (x0 + t F(x0) theta). Empty: the LP's. Where the LP's theta is not
+  /// unique (x0 on a switching surface from which several solutions start, as x' in sign(x) from
+  /// x(0) = 0), this chooses the solution the first step converges to; nosnoc's EXTERNAL
+  /// initialization. Stewart's form only (dcs_mode = "stewart").
+  Eigen::VectorXd theta_guess;
 };
 
 /// Empty if valid, else one line per broken rule: "discretization.n_s = 0: must be >= 1".

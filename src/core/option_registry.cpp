@@ -204,6 +204,11 @@ std::vector<Option> build() {
                     "constant control values, one per control (comma-separated)", "", true));
   o.push_back(input(kSim, "t0", Use::Simulation,
                     "initial value of the clock state (only used if t appears)", "", true));
+  o.push_back(
+      input(kSim, "theta_guess", Use::Simulation,
+            "guess of the Stewart weights theta of the first step (n_theta values in [0, "
+            "1]) instead of the LP's at x0: picks the branch where solutions are not unique",
+            "", true));
   o.push_back(scalar<&T::sensitivities>(
       kSim, "sensitivities", Use::Simulation,
       "compute dx(T)/dx0, dx(T)/du, dx(T)/dp (implicit function theorem per step, chained)", ""));

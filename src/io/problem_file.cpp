@@ -24,6 +24,7 @@
 #include "fesd/error.hpp"
 #include "fesd/pds_problem_file.hpp"
 #include "fesd/problem_file.hpp"
+#include "integrator/theta_guess.hpp"
 #include "io/option_target.hpp"
 #include "io/problem_file_reader.hpp"
 
@@ -43,6 +44,8 @@ std::vector<std::string> validate_all(const SimulationProblem& q) {
   if (options.empty())  // the limits of build(), docs/problem-files.md "Limits"
     options = discretization::FesdInterval::block_size_errors(q.model, q.options.discretization);
   for (std::string& s : options) e.push_back(std::move(s));
+  for (std::string& s : integrator::theta_guess_errors(q.model, q.options))
+    e.push_back(std::move(s));
   return e;
 }
 
@@ -111,6 +114,11 @@ SimulationProblem parse_simulation_problem(std::string_view toml_text,
       if (const toml::node* un = st->get("u"))
         problem.u =
             r.vector(*un, "simulation.u", problem.model.n_u(), "one per control in model.u");
+  if (const toml::node* sim = root.get("simulation"))
+    if (const toml::table* st = sim->as_table())
+      if (const toml::node* tn = st->get("theta_guess"))
+        problem.options.theta_guess = r.vector(*tn, "simulation.theta_guess",
+                                               problem.model.n_theta(), "one per region (n_theta)");
 
   read_options(r, root, problem);
   return problem;
@@ -138,6 +146,9 @@ void apply_override(SimulationProblem& problem, std::string_view key, std::strin
   } else if (input == "u") {
     updated.u =
         override_vector(head, value, updated.model.n_u(), "simulation.u", "one per control");
+  } else if (input == "theta_guess") {
+    updated.options.theta_guess = override_vector(head, value, updated.model.n_theta(),
+                                                  "simulation.theta_guess", "one per region");
   } else if (set_model_override(arg, updated.model, updated.has_clock, updated.x0, updated.p)) {
     // [model] x0 or one parameter
   } else if (arg.table == "ipopt" && !arg.key.empty()) {

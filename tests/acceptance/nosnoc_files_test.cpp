@@ -69,19 +69,50 @@ TEST(NosnocFiles, OscillatorExampleMatchesTheExactSolution) {
   EXPECT_NEAR(r.switches[0].t, 1.0, 1e-6);
 }
 
-// x' in sign(x) from 0 has the solutions x = +-(t - t*): the state guess x(t) = t picks
-// x(2) = 2, the guess x(t) = -t the mirror image x(2) = -2.
-TEST(NosnocFiles, DifferentSwitchCasesBranchByTheGuess) {
-  fesd::OcpProblem p = fesd::load_ocp_problem(example_path("different_switch_cases.toml"));
-  fesd::OcpResult r = fesd::solve(p.ocp, p.options);
-  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
-  EXPECT_NEAR(r.x_final()[0], 2.0, 1e-6);
-  for (std::size_t i = 0; i < r.t.size(); ++i) EXPECT_NEAR(r.x[i][0], r.t[i], 1e-6) << i;
+// x' in sign(x) from 0 has the solutions x = 0 until t*, then x = +-(t - t*): the guess theta =
+// (0, 1) (region x > 0) picks x = t, (1, 0) its mirror image x = -t, (1/2, 1/2) x = 0 (sliding).
+TEST(NosnocFiles, DifferentSwitchCasesBranchByTheThetaGuess) {
+  fesd::SimulationProblem p =
+      fesd::load_simulation_problem(example_path("different_switch_cases.toml"));
+  for (const double sign : {1.0, -1.0, 0.0}) {
+    p.options.theta_guess = sign > 0   ? Eigen::Vector2d(0, 1)
+                            : sign < 0 ? Eigen::Vector2d(1, 0)
+                                       : Eigen::Vector2d(0.5, 0.5);
+    const fesd::IntegratorResult r = run(p);
+    ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+    EXPECT_NEAR(r.x_final()[0], 2.0 * sign, 1e-9) << sign;
+    for (std::size_t i = 0; i < r.t.size(); ++i) EXPECT_NEAR(r.x[i][0], sign * r.t[i], 1e-9) << i;
+  }
+}
 
-  for (auto& row : p.ocp.x_guess) row = -row;
-  r = fesd::solve(p.ocp, p.options);
-  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
-  EXPECT_NEAR(r.x_final()[0], -2.0, 1e-6);
+// theta_guess: one weight per region in [0, 1], Stewart's form only; file errors name the key.
+TEST(NosnocFiles, ThetaGuessBadInput) {
+  const std::string base = R"(
+[model]
+x = ["x"]
+c = ["x"]
+S = [[-1], [1]]
+F = [["-1"], ["1"]]
+x0 = [0.0]
+[simulation]
+T_sim = 1.0
+N_sim = 1
+)";
+  const auto message = [&](const std::string& extra) {
+    try {
+      fesd::parse_simulation_problem(base + extra, "bad.toml");
+    } catch (const std::exception& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message("theta_guess = [1.0]\n").find("theta_guess"), std::string::npos);
+  EXPECT_NE(message("theta_guess = [0.5, 1.5]\n").find("[0, 1]"), std::string::npos);
+  EXPECT_NE(message("theta_guess = [0.5, nan]\n").find("theta_guess"), std::string::npos);
+  EXPECT_NE(
+      message("theta_guess = [0.5, 0.5]\n[discretization]\ndcs_mode = \"step\"\n").find("dcs_mode"),
+      std::string::npos);
+  EXPECT_EQ(message("theta_guess = [0.5, 0.5]\n"), "no error");
 }
 
 // Periodic stick-slip with one contact: on x2 = 0.2 the state sticks while |x1| < 1 with
