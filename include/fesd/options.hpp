@@ -233,7 +233,8 @@ struct IntegratorOptions {
   /// state guess follows them (x0 + t F(x0) theta). Empty: the LP's. Where the LP's theta is not
   /// unique (x0 on a switching surface from which several solutions start, as x' in sign(x) from
   /// x(0) = 0), this chooses the solution the first step converges to; nosnoc's EXTERNAL
-  /// initialization. Stewart's form only (dcs_mode = "stewart").
+  /// initialization. Stewart's form only (dcs_mode = "stewart"); integrate() and simulate() (the
+  /// Stepper rejects it: it guesses from the LP at every cold start).
   Eigen::VectorXd theta_guess;
 };
 

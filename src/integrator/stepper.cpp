@@ -39,6 +39,10 @@ std::vector<std::string> stepper_errors(const Pss& model, double h, const Integr
   if (o.sensitivities)
     e.push_back(
         "sensitivities = true: not computed by the Stepper; use integrate() with sensitivities");
+  if (o.theta_guess.size() > 0)
+    e.push_back(
+        "theta_guess: the guess of integrate()'s first step; the Stepper guesses theta from the "
+        "LP at every cold start (leave theta_guess empty, or use integrate())");
   if (o.discretization.dcs_mode == DcsMode::Step)
     e.push_back(
         "discretization.dcs_mode = step: the Stepper runs the active-set path, written in "

@@ -132,6 +132,9 @@ TEST(Stepper, OptionsCheckedAtCreation) {
   o = {};
   o.sensitivities = true;
   EXPECT_NE(message(0.1, o).find("sensitivities"), std::string::npos);
+  o = {};
+  o.theta_guess = Eigen::Vector2d(1, 0);
+  EXPECT_NE(message(0.1, o).find("theta_guess"), std::string::npos);
   EXPECT_EQ(message(0.1, {}), "");
 }
 
