@@ -267,13 +267,21 @@ TEST(NosnocFiles, TimeFreezingOcpsLoadWithTheirClock) {
 // map applied to (0, vy0), and |vy(T)| < vy0 (measured 0.8645 vy0: two contact elements, one at
 // its bound 2 h). Solved with the script's elastic_ineq from initialization = simulation: the
 // constant guess (x0 everywhere) ends with the complementarity residual 0.264 (docs row 23).
-TEST(NosnocFiles, ElasticBallWithoutControlBouncesOffTheTopWall) {
+namespace {
+/// elastic_ball_in_box.toml over T = 0.1 in 2 control intervals with u = 0, and one override.
+fesd::OcpProblem uncontrolled_ball(std::string_view key, std::string_view value) {
   fesd::OcpProblem p = fesd::load_ocp_problem(example_path("elastic_ball_in_box.toml"));
   fesd::apply_override(p, "T", "0.1");
   fesd::apply_override(p, "N_stages", "2");
-  fesd::apply_override(p, "initialization", "simulation");
+  fesd::apply_override(p, key, value);
   p.ocp.lbu = Eigen::VectorXd::Zero(2);
   p.ocp.ubu = Eigen::VectorXd::Zero(2);
+  return p;
+}
+}  // namespace
+
+TEST(NosnocFiles, ElasticBallWithoutControlBouncesOffTheTopWall) {
+  const fesd::OcpProblem p = uncontrolled_ball("initialization", "simulation");
   const fesd::OcpResult r = fesd::solve(p.ocp, p.options);
   ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
   const Eigen::VectorXd x0 = p.ocp.x0;
@@ -322,12 +330,7 @@ TEST(NosnocFiles, ElasticBallWithoutControlBouncesOffTheTopWall) {
 // residual. (It used to report success: the discarded point's residual, 0 by construction, was
 // taken.) The ball of the test above from the constant guess, with the homotopy cut at 5 NLPs.
 TEST(NosnocFiles, FailedFixedActiveSetResolveKeepsTheResidual) {
-  fesd::OcpProblem p = fesd::load_ocp_problem(example_path("elastic_ball_in_box.toml"));
-  fesd::apply_override(p, "T", "0.1");
-  fesd::apply_override(p, "N_stages", "2");
-  fesd::apply_override(p, "N_homotopy", "5");
-  p.ocp.lbu = Eigen::VectorXd::Zero(2);
-  p.ocp.ubu = Eigen::VectorXd::Zero(2);
+  const fesd::OcpProblem p = uncontrolled_ball("N_homotopy", "5");
   const fesd::OcpResult r = fesd::solve(p.ocp, p.options);
   ASSERT_GE(r.homotopy.size(), 6u);
   EXPECT_TRUE(r.homotopy.back().active_set_fixed);
