@@ -2,6 +2,7 @@
 // files, issue 17 item 3), each run as written against a closed-form answer. The examples that
 // are also in NOSNOC-EXAMPLES.md's side-by-side table are tested in nosnoc_examples_test.cpp.
 #include <cmath>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -376,6 +377,89 @@ TEST(NosnocFiles, TemperatureControlOcpCoolsToTheBoundAndHoldsIt) {
   EXPECT_NEAR(r.u[0][0], 0.1, 1e-6);  // cooling with the least heating
   EXPECT_NEAR(r.u[1][0], 0.1, 1e-6);
   for (int k = 3; k < N; ++k) EXPECT_NEAR(r.u[k][0], 3.2, 1e-3) << "interval " << k;
+}
+
+}  // namespace
+
+namespace {
+
+// The step-form hoppers (rows 24 and 26 of docs/nosnoc-examples.md; their runs are long, so
+// this checks the files only, < 1 s). f_alpha is the script's theta(alpha) weighting of row 25's
+// region fields: theta_1 = alpha_1 + w, theta_2 = w alpha_3, theta_3 = w (1 - alpha_3) with
+// w = (1 - alpha_1)(1 - alpha_2), times the flight field (region 1) and the impulse fields
+// (regions 7, 8) of examples/nosnoc/hopper_ocp.toml, at random points (equal to round-off).
+Eigen::VectorXd theta_weighted(const fesd::Ocp& stewart, const Eigen::VectorXd& x,
+                               const Eigen::Vector3d& alpha, const Eigen::VectorXd& u) {
+  const int n = stewart.model.n_x();
+  Eigen::VectorXd flight(n), pos(n), neg(n);
+  const fesd::PssFunctions& f = stewart.model.functions();
+  f.f(0, x.data(), u.data(), stewart.p.data(), flight.data());
+  f.f(6, x.data(), u.data(), stewart.p.data(), pos.data());
+  f.f(7, x.data(), u.data(), stewart.p.data(), neg.data());
+  const double w = (1 - alpha[0]) * (1 - alpha[1]);
+  return (alpha[0] + w) * flight + w * alpha[2] * pos + w * (1 - alpha[2]) * neg;
+}
+
+TEST(NosnocFiles, HopperStepFilesWeightRow25FieldsByTheScriptsTheta) {
+  const fesd::OcpProblem stewart = fesd::load_ocp_problem(example_path("hopper_ocp.toml"));
+  const fesd::OcpProblem step = fesd::load_ocp_problem(example_path("hopper_ocp_step.toml"));
+  const fesd::OcpProblem exercise =
+      fesd::load_ocp_problem(example_path("hopper_exercise_ocp_step.toml"));
+  ASSERT_TRUE(step.ocp.model.has_f_alpha());
+  ASSERT_TRUE(exercise.ocp.model.has_f_alpha());
+  EXPECT_EQ(step.options.discretization.dcs_mode, fesd::DcsMode::Step);
+  EXPECT_EQ(exercise.options.discretization.dcs_mode, fesd::DcsMode::Step);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> U(-1.0, 1.0), A(0.0, 1.0);
+  for (int trial = 0; trial < 20; ++trial) {
+    Eigen::VectorXd x(9), u(4);
+    for (int i = 0; i < 9; ++i) x[i] = U(rng);
+    x[3] = 0.3 + 0.2 * U(rng);  // leg length
+    for (int i = 0; i < 4; ++i) u[i] = 10 * U(rng);
+    u[3] = 1 + A(rng);  // speed of time
+    Eigen::Vector3d alpha(A(rng), A(rng), A(rng));
+    if (trial < 8) alpha = Eigen::Vector3d(trial & 1, (trial >> 1) & 1, (trial >> 2) & 1);
+    const Eigen::VectorXd expected = theta_weighted(stewart.ocp, x, alpha, u);
+    Eigen::VectorXd got(9), got_exercise(9);
+    step.ocp.model.functions().f_alpha(x.data(), alpha.data(), u.data(), step.ocp.p.data(),
+                                       got.data());
+    // The exercise has no slack control: u = (u1, u2, s).
+    const Eigen::Vector3d u3(u[0], u[1], u[3]);
+    exercise.ocp.model.functions().f_alpha(x.data(), alpha.data(), u3.data(), exercise.ocp.p.data(),
+                                           got_exercise.data());
+    EXPECT_LE((got - expected).cwiseAbs().maxCoeff(), 1e-12 * (1 + expected.norm()))
+        << "trial " << trial;
+    EXPECT_LE((got_exercise - expected).cwiseAbs().maxCoeff(), 1e-12 * (1 + expected.norm()))
+        << "trial " << trial;
+  }
+  // Row 26 is row 25's problem but for the dynamics and the pair: the same data.
+  EXPECT_EQ(step.ocp.T, stewart.ocp.T);
+  EXPECT_EQ(step.ocp.N_stages, stewart.ocp.N_stages);
+  EXPECT_EQ(step.ocp.x0, stewart.ocp.x0);
+  EXPECT_EQ(step.ocp.lbx, stewart.ocp.lbx);
+  EXPECT_EQ(step.ocp.ubx, stewart.ocp.ubx);
+  EXPECT_EQ(step.ocp.lbu, stewart.ocp.lbu);
+  EXPECT_EQ(step.ocp.ubu, stewart.ocp.ubu);
+  EXPECT_EQ(step.ocp.p_stage, stewart.ocp.p_stage);
+  EXPECT_EQ(step.ocp.x_guess, stewart.ocp.x_guess);
+  EXPECT_EQ(step.ocp.n_g_rk_comp, 1);
+  EXPECT_TRUE(step.ocp.time_freezing);
+  EXPECT_FALSE(step.ocp.use_speed_of_time_variables);
+  // Row 24's reference: the parabola through start, apex (0.55, 0.75, 0, 0.1) and goal
+  // (1, 0.5, 0, 0.5) at the ends of intervals 10 and 20 of 20.
+  ASSERT_EQ(exercise.ocp.N_stages, 20);
+  ASSERT_EQ(exercise.ocp.p_stage.size(), 20u);
+  const Eigen::VectorXd& apex = exercise.ocp.p_stage[9];
+  const Eigen::VectorXd& goal = exercise.ocp.p_stage[19];
+  // p = (a_n, mu, x_goal, xr, yr, phir, lr, vxr, vyr, vphir, vlr)
+  EXPECT_NEAR(apex[3], 0.55, 1e-12);
+  EXPECT_NEAR(apex[4], 0.75, 1e-12);
+  EXPECT_NEAR(apex[6], 0.1, 1e-12);
+  EXPECT_NEAR(goal[3], 1.0, 1e-12);
+  EXPECT_NEAR(goal[4], 0.5, 1e-12);
+  EXPECT_NEAR(goal[6], 0.5, 1e-12);
+  EXPECT_EQ(exercise.ocp.n_g_rk_comp, 1);
+  EXPECT_TRUE(exercise.ocp.time_freezing);
 }
 
 }  // namespace
