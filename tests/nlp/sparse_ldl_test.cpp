@@ -411,6 +411,30 @@ TEST(SparseLdl, ZeroColumnsOfSingularMatricesAreNotDelayed) {
   EXPECT_LE(delayed_singular, delayed_regular + copies);
 }
 
+TEST(SparseLdl, SmallPivotsAreZeroOnlyInSmallMatrices) {
+  // Blocks [1 1; 1 1 + d] with d = 2^-50: the Schur complement is d exactly, 8.9e-16 of the
+  // largest entry (Ruiz leaves the blocks as they are), and the matrix is positive definite.
+  // Below 5000 rows d counts as zero (1e-14 of the largest entry): singular, IPOPT regularizes.
+  // From 5000 rows on only pivots below 1e-20 of it do (docs/kkt-solver.md, "Row 30"), so the
+  // factorization succeeds with no negative eigenvalue.
+  const double d = std::ldexp(1.0, -50);
+  const auto blocks = [&](int n) {
+    Triplets t;
+    t.n = n;
+    for (int i = 0; i < n; i += 2) {
+      t.add(i, i, 1.0);
+      t.add(i + 1, i, 1.0);
+      t.add(i + 1, i + 1, 1.0 + d);
+    }
+    return t;
+  };
+  const Triplets small = blocks(4998), large = blocks(5000);
+  Ma27 a(small, FESD_KKT_SPARSE), b(large, FESD_KKT_SPARSE);
+  EXPECT_EQ(a.factor(small.val), 3);
+  EXPECT_EQ(b.factor(large.val), 0);
+  EXPECT_EQ(b.negative(), 0);
+}
+
 TEST(SparseLdl, TooSmallWorkspaceIsNegotiated) {
   std::mt19937 rng(13);
   const Triplets t = random_kkt(rng, 150, 80, 0.0);

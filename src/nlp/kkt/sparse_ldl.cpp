@@ -63,8 +63,17 @@ struct Relax {
 };
 constexpr Relax kRelax[] = {{8, 1.0}, {16, 0.3}, {48, 0.05}};
 /// A pivot (1x1) or a 2x2 pivot's determinant scale below this fraction of the scaled matrix's
-/// largest entry counts as zero.
+/// largest entry counts as zero: kTinyRel below kLargeKktRows rows, kTinyRelLarge from there on.
+/// Threshold pivoting (u) keeps the factor stable whatever this is; it only decides which columns
+/// are "zero" and make the matrix singular (IFLAG = 3), upon which IPOPT regularizes. On
+/// hysteresis_car_control_time_optimal_2d (KKT order 24081) 1e-14 reported nonsingular matrices
+/// near mu = 1e-9..1e-11 singular: IPOPT took the Jacobian as degenerate, raised delta_x to
+/// 1e7-1e19 and ended with Restoration_Failed; with 1e-20 it converges (docs/kkt-solver.md,
+/// "Row 30"). The integrator's small NLPs need 1e-14: with 1e-16 or below four acceptance tests
+/// of the temperature control, stick-slip and PDS examples miss their tolerances.
 constexpr double kTinyRel = 1e-14;
+constexpr double kTinyRelLarge = 1e-20;
+constexpr int kLargeKktRows = 5000;
 /// A diagonal below this fraction of its row's largest entry makes a row "zero-diagonal" for the
 /// ordering's matching.
 constexpr double kZeroDiagRel = 1e-10;
@@ -1250,7 +1259,8 @@ FESD_KKT_KERNEL void sparse_factor(int n, int nz, const int* irn, const int* icn
       cval[sym.slot[e]] = v;
     }
   }
-  const double tiny = kTinyRel * std::max(amax, std::numeric_limits<double>::min());
+  const double tiny = (n >= kLargeKktRows ? kTinyRelLarge : kTinyRel) *
+                      std::max(amax, std::numeric_limits<double>::min());
   const double u = std::clamp(pivtol, kMinPivtol, kMaxPivtol);
 
   // Multifrontal factorization; children (smaller last columns) come before their parent.
