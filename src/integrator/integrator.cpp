@@ -131,7 +131,10 @@ class Integrator {
     settings_cannot_reach_ = !res_.summary.warnings.empty();
     // Initial guess of the first step: the LP at x0 (then the last stage of the step before).
     guess_ = dcs::solve_start(model_, d_.dcs_mode, x0, p_);
-    if (options.theta_guess.size() > 0) user_theta_guess(options.theta_guess);
+    // IntegratorOptions::theta_guess replaces the LP's theta; lambda and mu stay the LP's (on a
+    // switching surface, where the guess matters, the g_i of the regions meeting there are equal,
+    // so their lambda_i = 0 either way).
+    if (options.theta_guess.size() > 0) guess_.theta = options.theta_guess;
     guess_xdot_ = xdot_at(x0, guess_.theta);
     // The standard method (use_fesd = false) has no free lengths to carry a switch: it always
     // runs on the homotopy path, whatever step_solver says.
@@ -918,11 +921,6 @@ class Integrator {
           "element boundaries reach it",
           d_.gamma_h);
   }
-
-  /// IntegratorOptions::theta_guess replaces the LP's theta of the first step's guess; lambda and
-  /// mu stay the LP's (on a switching surface, where the guess matters, the g_i of the regions
-  /// meeting there are equal, so their lambda_i = 0 either way).
-  void user_theta_guess(const Eigen::VectorXd& theta) { guess_.theta = theta; }
 
   Eigen::VectorXd xdot_at(const Eigen::VectorXd& x, const Eigen::VectorXd& theta) const {
     Eigen::VectorXd xd(model_.n_x());

@@ -110,15 +110,14 @@ SimulationProblem parse_simulation_problem(std::string_view toml_text,
 
   problem.u = Eigen::VectorXd::Zero(problem.model.n_u());
   if (const toml::node* sim = root.get("simulation"))
-    if (const toml::table* st = sim->as_table())
+    if (const toml::table* st = sim->as_table()) {
       if (const toml::node* un = st->get("u"))
         problem.u =
             r.vector(*un, "simulation.u", problem.model.n_u(), "one per control in model.u");
-  if (const toml::node* sim = root.get("simulation"))
-    if (const toml::table* st = sim->as_table())
       if (const toml::node* tn = st->get("theta_guess"))
         problem.options.theta_guess = r.vector(*tn, "simulation.theta_guess",
                                                problem.model.n_theta(), "one per region (n_theta)");
+    }
 
   read_options(r, root, problem);
   return problem;
