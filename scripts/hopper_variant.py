@@ -1,11 +1,11 @@
 #!/usr/bin/env python3
-"""Writes a variant of examples/nosnoc/hopper_ocp.toml to stdout: another goal x_goal, number of
-control intervals N_stages, one jump or several (--multijump: round(x_goal - 0.1) jumps), with or
-without the reference as initial guess (--no_guess). The reference is, per jump, the parabola
+"""Writes a variant of examples/nosnoc/hopper_ocp.toml (--step: hopper_ocp_step.toml) to stdout:
+another goal x_goal, number of control intervals N_stages, one jump or several (--multijump:
+round(x_goal - 0.1) jumps), with or without the reference as initial guess (--no_guess). The reference is, per jump, the parabola
 through start, apex (x halfway, y = 1, l = 0.1) and landing (y = 0.5, l = 0.5) at s = 0, 1/2, 1
 (nosnoc_py's three-point cubic spline with not-a-knot ends), sampled as nosnoc_py's hopper
 scripts do; p_time_var gets the value at the end of every control interval. Used for rows 27 and
-28 of docs/nosnoc-examples.md:
+28 of docs/nosnoc-examples.md (scripts/hopper_sweep.py runs them):
 
   python3 scripts/hopper_variant.py --x_goal 3 --N_stages 60 --multijump > /tmp/hopper60.toml
 
@@ -53,8 +53,10 @@ def main():
     a.add_argument("--N_stages", type=int, default=50)
     a.add_argument("--multijump", action="store_true")
     a.add_argument("--no_guess", action="store_true")
+    a.add_argument("--step", action="store_true", help="the Heaviside step form (row 26's file)")
     args = a.parse_args()
-    base = pathlib.Path(__file__).resolve().parent.parent / "examples/nosnoc/hopper_ocp.toml"
+    name = "hopper_ocp_step.toml" if args.step else "hopper_ocp.toml"
+    base = pathlib.Path(__file__).resolve().parent.parent / "examples/nosnoc" / name
     text = base.read_text()
     n, T = args.N_stages, 5.0
     rows = reference(n, args.x_goal, args.multijump)

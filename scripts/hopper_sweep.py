@@ -1,0 +1,154 @@
+#!/usr/bin/env python3
+"""Runs nosnoc_py's two hopper sweeps with fesd (docs/nosnoc-examples.md, rows 27 and 28).
+
+  ns      examples/hopper_robot/ns_experiment.py: x_goal = 3, one jump, 50 control intervals,
+          n_s = 2..7, the reference not used as guess; the step form and Stewart's form.
+  stages  examples/hopper_robot/stage_experiment.py: x_goal = 3, three jumps, n_s = 2,
+          N_stages = 60, 66, ..., 108, the reference as guess; both forms.
+
+Each point writes its variant with scripts/hopper_variant.py into a temporary directory, runs
+`fesd solve VARIANT --json OUT` and reads status, objective, IPOPT iterations and the CPU time of
+the NLPs (the sum over the homotopy, as nosnoc_py's cpu_time_nlp). It prints one row per point;
+--csv writes them, --plot draws the scripts' two figures (CPU time, and CPU time per IPOPT
+iteration, over n_s or N, step form against Stewart's). Nothing is written unless asked.
+
+  python3 scripts/hopper_sweep.py ns --points 2,3 --csv /tmp/ns.csv --plot /tmp/ns.png
+"""
+import argparse
+import csv
+import json
+import pathlib
+import subprocess
+import sys
+import tempfile
+import time
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+EXPERIMENTS = {
+    # name: (swept key, default points, variant flags, per form: no reference guess?)
+    "ns": ("n_s", [2, 3, 4, 5, 6, 7], ["--x_goal", "3"], {"step": True, "stewart": True}),
+    "stages": ("N_stages", [60, 66, 72, 78, 84, 90, 96, 102, 108],
+               ["--x_goal", "3", "--multijump"], {"step": False, "stewart": False}),
+}
+FIELDS = ["form", "key", "value", "status", "objective", "comp_residual", "nlps", "ipopt_iterations",
+          "cpu_nlp_s", "cpu_per_iteration_s", "wall_s", "x_final"]
+
+
+def variant(form, key, value, flags, no_guess, directory):
+    args = [sys.executable, str(ROOT / "scripts/hopper_variant.py")] + flags
+    if key == "N_stages":
+        args += ["--N_stages", str(value)]
+    if no_guess:
+        args.append("--no_guess")
+    if form == "step":
+        args.append("--step")
+    text = subprocess.run(args, check=True, capture_output=True, text=True).stdout
+    path = pathlib.Path(directory) / f"hopper_{form}_{key}_{value}.toml"
+    path.write_text(text)
+    return path
+
+
+def run_point(fesd, form, key, value, flags, no_guess, timeout, directory):
+    path = variant(form, key, value, flags, no_guess, directory)
+    out = path.with_suffix(".json")
+    cmd = [fesd, "solve", str(path), "--json", str(out), "--quiet"]
+    if key == "n_s":
+        cmd += ["--n_s", str(value)]
+    start = time.monotonic()
+    try:
+        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+        code = proc.returncode
+    except subprocess.TimeoutExpired:
+        code = None
+    wall = time.monotonic() - start
+    row = dict(form=form, key=key, value=value, wall_s=round(wall, 1))
+    if code is None or not out.exists():
+        row["status"] = "timeout" if code is None else f"exit {code}"
+        return row
+    r = json.loads(out.read_text())
+    rows = r.get("homotopy", [])
+    iterations = sum(h["nlp_iterations"] for h in rows)
+    cpu = sum(h["cpu_s"] for h in rows)
+    row.update(status=r["status"], objective=r["objective"],
+               comp_residual=r["stats"]["comp_residual"], nlps=len(rows),
+               ipopt_iterations=iterations, cpu_nlp_s=round(cpu, 2),
+               cpu_per_iteration_s=round(cpu / iterations, 4) if iterations else None,
+               x_final=" ".join("%.4g" % v for v in r["x_final"]))
+    return row
+
+
+def plot(rows, key, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(1, 2, figsize=(9, 3.6))
+    for form, style in (("step", "Xb-"), ("stewart", "Xr-")):
+        pts = [r for r in rows if r["form"] == form and r.get("cpu_nlp_s") is not None]
+        label = "Step" if form == "step" else "Stewart"
+        axes[0].plot([r["value"] for r in pts], [r["cpu_nlp_s"] for r in pts], style, label=label)
+        axes[1].plot([r["value"] for r in pts], [r["cpu_per_iteration_s"] for r in pts], style,
+                     label=label)
+    name = "$n_s$" if key == "n_s" else "$N$ (control intervals)"
+    axes[0].set_ylabel("CPU time of the NLPs [s]")
+    axes[1].set_ylabel("CPU time per IPOPT iteration [s]")
+    for ax in axes:
+        ax.set_xlabel(name)
+        ax.grid(True)
+        ax.legend(loc="best")
+    fig.suptitle(f"fesd, hopper, x_goal = 3: sweep over {key}")
+    fig.tight_layout()
+    fig.savefig(path, dpi=80)
+
+
+def main():
+    a = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    a.add_argument("experiment", choices=sorted(EXPERIMENTS))
+    a.add_argument("--points", help="comma-separated values of n_s or N_stages (default: the script's)")
+    a.add_argument("--forms", default="step,stewart", help="step, stewart or both (default)")
+    a.add_argument("--fesd", default=str(ROOT / "build/fesd"))
+    a.add_argument("--timeout", type=float, default=3600, help="seconds per point")
+    a.add_argument("--csv", help="write the rows as CSV")
+    a.add_argument("--plot", help="draw the scripts' two figures (PNG/SVG)")
+    args = a.parse_args()
+    key, points, flags, no_guess = EXPERIMENTS[args.experiment]
+    if args.points:
+        try:
+            points = [int(v) for v in args.points.split(",")]
+        except ValueError:
+            a.error(f"--points: not a list of integers: '{args.points}'")
+    forms = args.forms.split(",")
+    for f in forms:
+        if f not in no_guess:
+            a.error(f"--forms: unknown form '{f}' (step, stewart)")
+    if args.plot:
+        try:
+            import matplotlib  # noqa: F401
+        except ImportError:
+            a.error("--plot needs matplotlib (Debian: python3-matplotlib, e.g. run /usr/bin/python3)")
+    if not pathlib.Path(args.fesd).exists():
+        a.error(f"no fesd binary at {args.fesd} (build it or pass --fesd)")
+    rows = []
+    print("%-8s %4s %-24s %12s %9s %5s %6s %9s %8s" % ("form", key[:4], "status", "objective",
+          "comp", "NLPs", "iter", "CPU s", "s/iter"), flush=True)
+    with tempfile.TemporaryDirectory() as directory:
+        for value in points:
+            for form in forms:
+                r = run_point(args.fesd, form, key, value, flags, no_guess[form], args.timeout,
+                              directory)
+                rows.append(r)
+                print("%-8s %4d %-24s %12s %9s %5s %6s %9s %8s" % (
+                    form, value, r["status"], "%.6g" % r["objective"] if "objective" in r else "-",
+                    "%.1e" % r["comp_residual"] if "comp_residual" in r else "-",
+                    r.get("nlps", "-"), r.get("ipopt_iterations", "-"), r.get("cpu_nlp_s", "-"),
+                    r.get("cpu_per_iteration_s", "-")), flush=True)
+    if args.csv:
+        with open(args.csv, "w", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=FIELDS)
+            w.writeheader()
+            w.writerows(rows)
+    if args.plot:
+        plot(rows, key, args.plot)
+
+
+if __name__ == "__main__":
+    main()
