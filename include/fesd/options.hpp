@@ -167,6 +167,12 @@ struct HomotopyOptions {
   /// down to complementarity_tol). Measured (docs/formulation.md): 1e-3 ends OCP (61) on another
   /// branch (cost 9.1710 instead of 9.1685); 1e-4 keeps every example's cost.
   double active_set_sigma = 1e-4;
+  /// `s_elastic_max` > 0 (optimal control, elastic_ineq and elastic_two_sided): upper bound of
+  /// the elastic variable s. Default 1e20: unbounded. nosnoc's s_elastic_max (its default 10).
+  double s_elastic_max = 1e20;
+  /// `s_elastic_0` >= 0, <= s_elastic_max (optimal control, elastic modes): the first NLP's guess
+  /// of s. nosnoc's s_elastic_0 (its default 1).
+  double s_elastic_0 = 0.0;
 };
 
 /// The linear solver behind IPOPT's KKT systems (docs/kkt-solver.md).

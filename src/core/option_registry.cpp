@@ -130,6 +130,12 @@ std::string fesd_needs_two_elements(const T& t, double N_FE) {
          "use_fesd = false";
 }
 
+std::string s_elastic_0_at_most_max(const T& t, double s0) {
+  const double s_max = t.homotopy->s_elastic_max;
+  if (!(std::isfinite(s_max) && s_max > 0) || s0 <= s_max) return {};
+  return fmt::format("must be <= s_elastic_max = {}", s_max);
+}
+
 std::string sigma_N_at_most_sigma_0(const T& t, double sigma_N) {
   const double sigma_0 = t.homotopy->sigma_0;
   if (!(std::isfinite(sigma_0) && sigma_0 > 0) || sigma_N <= sigma_0) return {};
@@ -361,6 +367,15 @@ std::vector<Option> build() {
       kHom, "active_set_sigma", kBoth,
       "end the homotopy with the active set fixed once it is stable at sigma <= this", "",
       Range{.min = 0, .note = "(0: off)"}));
+  o.push_back(scalar<&T::homotopy, &H::s_elastic_max>(
+      kHom, "s_elastic_max", Use::Ocp,
+      "upper bound of the elastic variable s (elastic_ineq, elastic_two_sided; 1e20: none)",
+      "s_elastic_max", kPositive));
+  with(scalar<&T::homotopy, &H::s_elastic_0>(
+           kHom, "s_elastic_0", Use::Ocp,
+           "first guess of the elastic variable s (elastic_ineq, elastic_two_sided)", "s_elastic_0",
+           Range{.min = 0}),
+       [](Option& x) { x.rule = s_elastic_0_at_most_max; });
   o.push_back(scalar<&T::homotopy, &H::fix_active_set>(
       kHom, "fix_active_set", Use::Simulation,
       "solve each step's last NLP once more with its active set fixed (exact complementarity)",

@@ -82,7 +82,9 @@ class Problem {
   /// Relaxes the groups in `mode` (Relaxation: rows, variables or objective terms; throws
   /// fesd::InvalidOption when the mode cannot express a group). After the last
   /// add_complementarity(); the variables are then complete (copy_inputs_from() works).
-  void relax(MpccMode mode);
+  /// `s_elastic_max`, `s_elastic_0`: bounds [0, s_elastic_max] and guess of the elastic variable
+  /// (elastic modes; HomotopyOptions).
+  void relax(MpccMode mode, double s_elastic_max = nlp::kInf, double s_elastic_0 = 0.0);
   /// Builds the sparsity of the NLP, probed at the current guess. After relax().
   void finalize();
   bool finalized() const { return nlp_.finalized(); }

@@ -112,7 +112,8 @@ void set_sigma(nlp::BlockNlp& nlp, const std::vector<int>& rows, double sigma) {
   }
 }
 
-Relaxation::Relaxation(nlp::BlockNlp& nlp, const std::vector<CompGroup>& groups, MpccMode mode)
+Relaxation::Relaxation(nlp::BlockNlp& nlp, const std::vector<CompGroup>& groups, MpccMode mode,
+                       double s_max, double s_0)
     : mode_(mode), group_rows_(groups.size(), -1) {
   if (mode == MpccMode::ScholtesIneq) {
     // Exactly the rows of add_scholtes_rows (results stay bit-identical to it), empty groups
@@ -128,7 +129,7 @@ Relaxation::Relaxation(nlp::BlockNlp& nlp, const std::vector<CompGroup>& groups,
   if (mode == MpccMode::FischerBurmeister)  // sigma enters the rows as a variable fixed by bounds
     sigma_var_ = nlp.add_variables(1, 1.0, 1.0, 1.0);  // IPOPT removes it (make_parameter)
   const bool elastic = mode == MpccMode::ElasticIneq || mode == MpccMode::ElasticTwoSided;
-  if (elastic) elastic_var_ = nlp.add_variables(1, 0.0, nlp::kInf, 0.0);
+  if (elastic) elastic_var_ = nlp.add_variables(1, 0.0, s_max, s_0);
 
   for (std::size_t k = 0; k < groups.size(); ++k) {
     const CompGroup& g = groups[k];

@@ -15,12 +15,18 @@
 //                       factor (cross_comp_mode element, neighbor) are rejected: they are not one
 //                       complementarity pair.
 //   ell_1_penalty       objective += (1 / sigma) * sum of all G      (no rows)
-//   elastic_ineq        G <= s for every group with one variable s >= 0, objective += s / sigma
+//   elastic_ineq        G <= s for every group with one variable s in [0, s_max],
+//                       objective += s / sigma
 //   elastic_two_sided   -s <= G <= s for every group (two-sided ones included: the one mode in
 //                       which a free-sign product is penalized rather than Scholtes-bounded, by
-//                       the bound s on |G|), one s >= 0, objective += s / sigma (nosnoc:
+//                       the bound s on |G|), one s in [0, s_max], objective += s / sigma (nosnoc:
 //                       ELASTIC_TWO_SIDED). For groups with G >= 0 the lower row is inactive and
 //                       the mode equals elastic_ineq.
+//
+// The elastic variable s is nosnoc's s_elastic, in [s_elastic_min, s_elastic_max] with the guess
+// s_elastic_0. fesd's defaults (HomotopyOptions::s_elastic_max = 1e20, i.e. unbounded, and
+// s_elastic_0 = 0) are not nosnoc's (10 and 1, in MATLAB nosnoc and nosnoc_py alike): the
+// problem files that reproduce nosnoc's examples set them.
 //
 // ell_1_penalty and elastic_ineq are exact penalties: once 1 / sigma exceeds the multipliers of
 // the complementarity constraints, their NLP solution is complementary (up to IPOPT's tolerance),
@@ -53,7 +59,9 @@ class Relaxation {
   /// Adds rows / variables / objective terms for `groups` to `nlp` (before nlp.finalize()).
   /// Throws fesd::InvalidOption naming the problem when the mode cannot express a group
   /// (fischer_burmeister on a group without a common factor).
-  Relaxation(nlp::BlockNlp& nlp, const std::vector<CompGroup>& groups, MpccMode mode);
+  /// `s_max`, `s_0`: bounds [0, s_max] and guess of the elastic variable (elastic modes only).
+  Relaxation(nlp::BlockNlp& nlp, const std::vector<CompGroup>& groups, MpccMode mode,
+             double s_max = nlp::kInf, double s_0 = 0.0);
 
   /// Sets sigma: row bounds, the fixed sigma variable (fischer_burmeister), objective weights
   /// 1 / sigma (ell_1_penalty, elastic_ineq).

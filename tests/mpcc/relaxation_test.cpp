@@ -393,6 +393,32 @@ TEST_P(TwoSided, StayScholtesRowsInEveryMode) {
 }
 INSTANTIATE_TEST_SUITE_P(Modes, TwoSided, ::testing::ValuesIn(kAllModes), mode_name);
 
+// The elastic variable s of elastic_ineq and elastic_two_sided is nosnoc's s_elastic: s in
+// [0, s_elastic_max] starting at s_elastic_0, fesd's defaults unbounded (1e20) and 0, nosnoc's
+// (MATLAB nosnoc and nosnoc_py alike) 10 and 1; sigma changes only its objective weight 1 / sigma,
+// not its bounds.
+TEST(ElasticVariable, BoundsAndStart) {
+  for (MpccMode mode : {MpccMode::ElasticIneq, MpccMode::ElasticTwoSided}) {
+    for (const bool nosnoc : {false, true}) {
+      auto b =
+          build(fesd::RkScheme::RadauIIA, 2, fesd::StageLambdaSign::All, fesd::CrossComp::StageSum);
+      auto& nlp = b->nlp;
+      const fesd::HomotopyOptions def;
+      const double s_max = nosnoc ? 10.0 : def.s_elastic_max;
+      const double s_0 = nosnoc ? 1.0 : def.s_elastic_0;
+      const fesd::mpcc::Relaxation relaxation(nlp, b->iv->groups(), mode, s_max, s_0);
+      const int v = relaxation.elastic_variable();
+      ASSERT_GE(v, 0) << fesd::to_string(mode);
+      for (double sigma : {1.0, 1e-3}) {
+        relaxation.set_sigma(nlp, sigma);
+        EXPECT_EQ(nlp.x_lb[v], 0.0) << fesd::to_string(mode);
+        EXPECT_EQ(nlp.x_ub[v], nosnoc ? 10.0 : 1e20) << fesd::to_string(mode);
+        EXPECT_EQ(nlp.x_init[v], nosnoc ? 1.0 : 0.0) << fesd::to_string(mode);
+      }
+    }
+  }
+}
+
 // ---- the option -------------------------------------------------------------------------------
 
 TEST(MpccModeOption, ReadFromProblemFilesAndOverrides) {

@@ -435,5 +435,40 @@ TEST(OcpElasticTwoSidedSliding, SameObjectiveAsTheDefault) {
   EXPECT_EQ(r.switches.size(), def.switches.size());
 }
 
+// [homotopy] s_elastic_max, s_elastic_0 (nosnoc's s_elastic_max, s_elastic_0): the elastic
+// variable s lies in [0, s_elastic_max] and bounds every complementarity product, so a tiny bound
+// makes the first NLP (sigma_0 = 1, weight 1) nearly complementary: residual <= 1e-9 (up to
+// IPOPT's tolerance) instead of 0.48 with s unbounded (fesd's default). With nosnoc's values (10,
+// 1) elastic_ineq reaches the default method's objective on the sliding-mode OCP.
+TEST(OcpElasticVariable, BoundFromTheFileReachesTheNlp) {
+  OcpProblem q = example("nosnoc/ocp_sliding_mode_nosnoc.toml");
+  const OcpResult def = solve(q.ocp, q.options);
+  ASSERT_EQ(def.status, Status::Success) << def.message;
+  apply_override(q, "mpcc_mode", "elastic_ineq");
+  const OcpResult unbounded = solve(q.ocp, q.options);
+  ASSERT_FALSE(unbounded.homotopy.empty());
+  EXPECT_GT(unbounded.homotopy.front().comp_residual, 0.4);
+  apply_override(q, "s_elastic_max", "1e-9");
+  EXPECT_EQ(q.options.homotopy.s_elastic_max, 1e-9);
+  const OcpResult tiny = solve(q.ocp, q.options);
+  ASSERT_FALSE(tiny.homotopy.empty());
+  EXPECT_LE(tiny.homotopy.front().comp_residual, 1.1e-9);
+  apply_override(q, "homotopy.s_elastic_max", "10");
+  apply_override(q, "s_elastic_0", "1");
+  EXPECT_EQ(q.options.homotopy.s_elastic_0, 1.0);
+  const OcpResult nosnoc = solve(q.ocp, q.options);
+  ASSERT_EQ(nosnoc.status, Status::Success) << nosnoc.message;
+  EXPECT_NEAR(nosnoc.objective, def.objective, 1e-6);
+  // s_elastic_0 above s_elastic_max is refused, naming both.
+  try {
+    apply_override(q, "s_elastic_0", "20");
+    ADD_FAILURE() << "s_elastic_0 > s_elastic_max accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("s_elastic_0 = 20: must be <= s_elastic_max = 10"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace fesd
