@@ -388,9 +388,9 @@ def fig_sliding_mode():
 
 # ---- row 29: the hysteresis car ---------------------------------------------------------------
 def fig_hysteresis_car():
-    # MUMPS: with the default kkt_solver (sparse_ldl here) this build's run ends nlp_failed
-    # (Infeasible_Problem_Detected from NLP 2 on; docs/nosnoc-figures.md, row 29)
-    d = run("solve", "hysteresis_car_control_time_optimal", extra=["--kkt_solver", "mumps"])
+    # The file selects MUMPS (with sparse_ldl the run ends nlp_failed: docs/nosnoc-examples.md,
+    # row 29).
+    d = run("solve", "hysteresis_car_control_time_optimal")
     t, x = boundaries(d), arr(d, "x")
     names = ["q (position)", "v (speed)", "L (fuel)", "w (auxiliary)", "t (time)"]
     fig, axes = plt.subplots(2, 2, figsize=FIGSIZE)

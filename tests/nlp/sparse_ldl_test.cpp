@@ -116,10 +116,6 @@ class Ma27 {
   }
   int negative() const { return info_[14]; }
   int reallocations() const { return reallocations_; }
-  /// MA27's CNTL(1), IPOPT's ma27_pivtol (raised by IPOPT when a solve was inaccurate).
-  void set_pivtol(double u) { cntl_[0] = u; }
-  /// The sparse factorization's row scaling, kept in A behind the values.
-  std::vector<double> scaling() const { return {a_.begin() + nz_, a_.begin() + nz_ + t_.n}; }
   void shrink_la(int la) {
     la_ = la;
     a_.assign(static_cast<std::size_t>(la_), 0.0);
@@ -271,65 +267,6 @@ TEST(SparseLdl, WarmStartedScalingOnLargeMatrices) {
     const Eigen::VectorXd x = solver.solve(b);
     EXPECT_LT(backward_error(values == &t ? K : K1, x, b), 1e-14);
   }
-}
-
-TEST(SparseLdl, ScalingFromTheIdentityOnceThePivotToleranceIsRaised) {
-  // KKT matrices of at least 5000 rows warm-start the scaling from the previous factorization's
-  // (one Ruiz sweep) while CNTL(1) is IPOPT's default 1e-8; once IPOPT raises it (an inaccurate
-  // solve), every factorization scales from the identity (three sweeps), as a first factorization
-  // does, so its scaling and factor no longer depend on the matrices factorized before
-  // (docs/kkt-solver.md, "Row 31").
-  std::mt19937 rng(31);
-  const int n = 3000, m = 2100;
-  Triplets t = random_kkt(rng, n, m, 1e-4);
-  // H + 6 I is diagonally dominant (off-diagonal row sums < 5), -1e-4 I on the constraints: the
-  // matrix is quasi-definite, one negative eigenvalue per constraint, whatever the scaling.
-  for (int i = 0; i < n; ++i) t.add(i, i, 6.0);
-  ASSERT_GE(t.n, 5000);
-  std::vector<double> d(static_cast<std::size_t>(t.n));
-  for (double& di : d) di = std::pow(10.0, static_cast<double>(rng() % 7));
-  Triplets scaled = t;
-  for (int e = 0; e < t.nz(); ++e) scaled.val[e] *= d[t.irn[e] - 1] * d[t.icn[e] - 1];
-  const auto berr = [&scaled](const Eigen::VectorXd& x, const Eigen::VectorXd& b) {
-    Eigen::VectorXd r = b, row_abs = Eigen::VectorXd::Zero(b.size());
-    for (int e = 0; e < scaled.nz(); ++e) {
-      const int i = scaled.irn[e] - 1, j = scaled.icn[e] - 1;
-      const double v = scaled.val[e];
-      r[i] -= v * x[j];
-      row_abs[i] += std::abs(v);
-      if (i != j) {
-        r[j] -= v * x[i];
-        row_abs[j] += std::abs(v);
-      }
-    }
-    return r.lpNorm<Eigen::Infinity>() /
-           (row_abs.maxCoeff() * x.lpNorm<Eigen::Infinity>() + b.lpNorm<Eigen::Infinity>());
-  };
-  const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(t.n, -1, 1);
-  // The reference at u = 1e-6 from the start: t (its values give the ordering), then the scaled
-  // matrix, both scaled from the identity.
-  Ma27 fresh(t, FESD_KKT_SPARSE);
-  fresh.set_pivtol(1e-6);
-  ASSERT_EQ(fresh.factor(t.val), 0);
-  ASSERT_EQ(fresh.factor(scaled.val), 0);
-  EXPECT_EQ(fresh.negative(), m);
-  const std::vector<double> cold = fresh.scaling();
-  const Eigen::VectorXd x_cold = fresh.solve(b);
-  // After t at the default 1e-8 the same matrix is scaled warm (from t's scaling): different.
-  Ma27 solver(t, FESD_KKT_SPARSE);
-  ASSERT_EQ(solver.factor(t.val), 0);
-  ASSERT_EQ(solver.factor(scaled.val), 0);
-  EXPECT_NE(solver.scaling(), cold);
-  EXPECT_EQ(solver.negative(), m);
-  // u raised to 1e-6 (IPOPT's first increase): the identity's scaling, the same factor and
-  // solution bit for bit, whatever was factorized before.
-  solver.set_pivtol(1e-6);
-  ASSERT_EQ(solver.factor(scaled.val), 0);
-  EXPECT_EQ(solver.scaling(), cold);
-  EXPECT_EQ(solver.negative(), m);
-  const Eigen::VectorXd x = solver.solve(b);
-  EXPECT_EQ(x, x_cold);
-  EXPECT_LT(berr(x, b), 1e-14);
 }
 
 long long delayed_pivots() {

@@ -92,16 +92,6 @@ constexpr double kMaxPivtol = 0.5;
 /// homotopy path's co-dimension-2 exit of the periodic stick-slip
 /// (PeriodicStickSlipExit.BothContactsSlipWhenX1ReachesOne, sanitizer build; its KKT matrices
 /// have at most 424 rows, so they keep the three sweeps from the identity, bit for bit).
-///
-/// From kLargeKktRows rows on, only while CNTL(1) is at its floor kMinPivtol (IPOPT's default
-/// ma27_pivtol 1e-8): IPOPT raises it when a solve was inaccurate, and from then on every
-/// factorization of the NLP scales from the identity (at every size >= kWarmMinRows that made
-/// NosnocParticleDiscs.DiscsImpactIsInelasticAndConservesMomentum miss its tolerance). On
-/// hysteresis_car_control_time_optimal_3d (KKT order 24269, docs/kkt-solver.md "Row
-/// 31") the scaling warm-started through ~580 factorizations (factors 2e-6 .. 1024) gave, at
-/// u = 1e-6 and mu = 1e-11, 11103 negative pivots and two zero pivots where the matrix has 11013
-/// negative eigenvalues (MUMPS and the cold scaling agree): ~360 pivots below 1e-10 of the scaled
-/// matrix with random signs, IPOPT took the Jacobian as degenerate and raised delta_x to 1e2-1e6.
 constexpr bool kReuseScaling = true;
 constexpr int kWarmMinRows = 1000;
 constexpr int kWarmSweeps = 1;
@@ -1208,10 +1198,7 @@ FESD_KKT_KERNEL void sparse_factor(int n, int nz, const int* irn, const int* icn
   double* scale = a + nz;
   const auto a_addr = reinterpret_cast<std::uintptr_t>(a);
   const int a_lo = static_cast<int>(a_addr & 0x7fffffffU), a_hi = static_cast<int>(a_addr >> 31);
-  // Large matrices: not once IPOPT has raised the pivot tolerance (its solves were inaccurate);
-  // from then on the scaling is the matrix's own (three sweeps from the identity), not the run's.
-  const bool warm = kReuseScaling && n >= kWarmMinRows &&
-                    (n < kLargeKktRows || pivtol <= kMinPivtol) && cached && n >= kKScaleSlots &&
+  const bool warm = kReuseScaling && n >= kWarmMinRows && cached && n >= kKScaleSlots &&
                     keep[kKScaled] == 1 && keep[kKLa] == la && keep[kKAAddrLo] == a_lo &&
                     keep[kKAAddrHi] == a_hi;
   if (!warm) std::fill_n(scale, n, 1.0);
