@@ -333,44 +333,32 @@ def fig_motor():
          f"motor_with_friction.toml: J = {d['objective']:.6f}, switches of v1 dashed")
 
 
-def fig_simple_car():
-    d = run("solve", "simple_car_algebraic")
+def fig_car(name, controls):
+    """q and v (v = 15 dotted) over t, then one panel per control (index, label) as steps."""
+    d = run("solve", name)
     t, x = boundaries(d), arr(d, "x")
-    fig, axes = plt.subplots(3, 1, figsize=FIGSIZE, sharex=True)
+    fig, axes = plt.subplots(2 + len(controls), 1, figsize=FIGSIZE, sharex=True)
     axes[0].plot(t, x[:, 0])
     axes[0].set_ylabel("q")
     axes[1].plot(t, x[:, 1])
     axes[1].axhline(15, color="k", linestyle=":", linewidth=0.8)
     axes[1].set_ylabel("v")
-    control_steps(axes[2], d, 0, "u")
-    axes[2].set_ylabel("u")
-    axes[2].set_xlabel("time [s]")
+    for ax, (index, label) in zip(axes[2:], controls):
+        control_steps(ax, d, index, label)
+        ax.set_ylabel(label)
+    axes[-1].set_xlabel("time [s]")
     for ax in axes:
         switch_lines(ax, d)
         ax.grid(True)
-    save(fig, "simple_car_algebraic",
-         f"simple_car_algebraic.toml: J = {d['objective']:.6f} (v = 15 dotted, switches dashed)")
+    save(fig, name, f"{name}.toml: J = {d['objective']:.6f} (v = 15 dotted, switches dashed)")
+
+
+def fig_simple_car():
+    fig_car("simple_car_algebraic", [(0, "u")])
 
 
 def fig_car_control():
-    d = run("solve", "car_control_complementarity")
-    t, x = boundaries(d), arr(d, "x")
-    fig, axes = plt.subplots(4, 1, figsize=FIGSIZE, sharex=True)
-    axes[0].plot(t, x[:, 0])
-    axes[0].set_ylabel("q")
-    axes[1].plot(t, x[:, 1])
-    axes[1].axhline(15, color="k", linestyle=":", linewidth=0.8)
-    axes[1].set_ylabel("v")
-    control_steps(axes[2], d, 0, "u_a")
-    axes[2].set_ylabel("u_a")
-    control_steps(axes[3], d, 1, "u_b")
-    axes[3].set_ylabel("u_b")
-    axes[3].set_xlabel("time [s]")
-    for ax in axes:
-        switch_lines(ax, d)
-        ax.grid(True)
-    save(fig, "car_control_complementarity",
-         f"car_control_complementarity.toml: J = {d['objective']:.6f} (v = 15 dotted, switches dashed)")
+    fig_car("car_control_complementarity", [(0, "u_a"), (1, "u_b")])
 
 
 # ---- rows 16, 17, 20 with fesd's own plot -----------------------------------------------------
