@@ -78,6 +78,13 @@ def shrink(tag, name):
     compact(os.path.join(WORK, tag + ".png"), os.path.join(OUT, name + ".png"))
 
 
+def own_plot(command, tag):
+    """fesd's own plot (`fesd simulate|solve FILE --plot`) of examples/nosnoc/tag.toml, shrunk to
+    docs/img/nosnoc/tag.png."""
+    run(command, tag, plot=True)
+    shrink(tag, tag)
+
+
 def save(fig, name, title):
     fig.suptitle(title, fontsize=10)
     fig.tight_layout()
@@ -172,18 +179,15 @@ def fig_relay():
 
 # ---- rows 5-7 with fesd's own plot ------------------------------------------------------------
 def fig_friction_block():
-    run("simulate", "friction_block", plot=True)
-    shrink("friction_block", "friction_block")
+    own_plot("simulate", "friction_block")
 
 
 def fig_oscillator():
-    run("simulate", "oscillator_example", plot=True)
-    shrink("oscillator_example", "oscillator_example")
+    own_plot("simulate", "oscillator_example")
 
 
 def fig_stick_slip():
-    run("simulate", "periodic_stick_slip_codim1", plot=True)
-    shrink("periodic_stick_slip_codim1", "periodic_stick_slip_codim1")
+    own_plot("simulate", "periodic_stick_slip_codim1")
     d = run("simulate", "periodic_stick_slip")
     t, x = boundaries(d), arr(d, "x")
     fig = plt.figure(figsize=FIGSIZE)
@@ -363,15 +367,12 @@ def fig_car_control():
 
 # ---- rows 16, 17, 20 with fesd's own plot -----------------------------------------------------
 def fig_cart_pole():
-    run("solve", "cart_pole_with_friction", plot=True)
-    shrink("cart_pole_with_friction", "cart_pole_with_friction")
-    run("solve", "main_cartpole", plot=True)
-    shrink("main_cartpole", "main_cartpole")
+    own_plot("solve", "cart_pole_with_friction")
+    own_plot("solve", "main_cartpole")
 
 
 def fig_sliding_mode():
-    run("solve", "ocp_sliding_mode_nosnoc", plot=True)
-    shrink("ocp_sliding_mode_nosnoc", "ocp_sliding_mode_nosnoc")
+    own_plot("solve", "ocp_sliding_mode_nosnoc")
 
 
 # ---- row 29: the hysteresis car ---------------------------------------------------------------
