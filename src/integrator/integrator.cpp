@@ -838,12 +838,13 @@ class Integrator {
       const int n_pins = static_cast<int>(pins.size());
       const nlp::Iterate relaxed = sp.mpcc.iterate();
       const mpcc::HomotopyResult again = sp.mpcc.solve_again(solver(), hopt, bounds, n_pins);
-      mpcc::append(h, again);
       if (again.status != Status::Success || !near(*sp.iv, relaxed.x, sp.mpcc.solution(), sigma)) {
+        mpcc::append_discarded(h, again);  // the relaxed point, its residual and status stay
         sp.mpcc.restore(relaxed);
         before->second = std::move(now);
         return false;
       }
+      mpcc::append(h, again);
       ++res_.summary.active_set_solves;
       res_.summary.pinned_exits += n_pins;
       h.active_set_fixed = true;

@@ -60,11 +60,15 @@ double comp_residual(const double* x, const std::vector<CompPair>& pairs) {
   return r;
 }
 
-void append(HomotopyResult& to, const HomotopyResult& from) {
+void append_discarded(HomotopyResult& to, const HomotopyResult& from) {
   to.rows.insert(to.rows.end(), from.rows.begin(), from.rows.end());
   to.eval_s += from.eval_s;
   to.solver_s += from.solver_s;
   to.nlp_iterations += from.nlp_iterations;
+}
+
+void append(HomotopyResult& to, const HomotopyResult& from) {
+  append_discarded(to, from);
   to.comp_residual = from.comp_residual;
   to.last_nlp_status = from.last_nlp_status;
 }

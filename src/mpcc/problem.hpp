@@ -49,6 +49,10 @@ struct HomotopyResult {
 /// Appends the rows and work of `from` (a re-solve) to `to`; the residual and last status become
 /// those of `from`.
 void append(HomotopyResult& to, const HomotopyResult& from);
+/// Appends the rows and work of `from`, a re-solve whose point was discarded (it failed, or the
+/// caller restored the point before): `to`'s residual and last status stay those of the point
+/// kept, so a failed fixed-active-set NLP (residual 0 by construction) cannot pass for a success.
+void append_discarded(HomotopyResult& to, const HomotopyResult& from);
 
 /// Adds a homotopy's (or re-solve's) rows to `rows` and its work (NLPs, iterations, evaluation
 /// and solver time) to `summary`: the bookkeeping of every front end.

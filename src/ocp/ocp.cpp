@@ -356,20 +356,16 @@ std::function<bool(mpcc::HomotopyResult&)> early_active_set_finish(OcpNlp& b, co
                                        /*every_interval=*/true, bounds);
     const mpcc::HomotopyResult again = mp.solve_again(solver, o.homotopy, bounds, n_pins);
     if (o.on_homotopy_row) o.on_homotopy_row(again.rows.back());
-    // A failed re-solve is discarded (solve_again keeps the point before): its row and work are
-    // counted, but the residual and IPOPT status stay those of the point kept. Otherwise the
-    // fixed active set's residual (0 by construction) would end the homotopy as a success when
-    // this was its last NLP.
-    const double kept_residual = h.comp_residual;
-    const std::string kept_status = h.last_nlp_status;
-    mpcc::append(h, again);
+    // A failed re-solve is discarded (solve_again keeps the point before): counted, but the
+    // residual and status stay the kept point's (else it would end the homotopy as a success
+    // when this was its last NLP).
     if (again.status != Status::Success) {
-      h.comp_residual = kept_residual;
-      h.last_nlp_status = kept_status;
+      mpcc::append_discarded(h, again);
       ++summary.active_set_failures;
       seen->failed = std::move(now);
       return false;
     }
+    mpcc::append(h, again);
     ++summary.active_set_solves;
     summary.pinned_exits = n_pins;
     finished = true;
