@@ -141,6 +141,13 @@ struct HomotopyOptions {
   /// `N_homotopy`: maximum number of NLPs per solve, 0..1000. 0 (default): enough for sigma to
   /// reach sigma_N, ceil(log(sigma_N / sigma_0) / log(slope)) + 1 (13 with the defaults).
   int max_homotopy_steps = 0;
+  /// `homotopy_retries` 0..100 (optimal control; an integration step has its own retry policy and
+  /// ignores it): an NLP that fails after a converged one is discarded and the
+  /// homotopy goes back to the converged NLP's point with half the logarithmic sigma step
+  /// (sigma = sqrt(sigma_good * sigma_failed)), then on to the failed sigma; at most this many
+  /// times per homotopy (each retry is one NLP more than N_homotopy). 0: go on from the failed
+  /// point, as nosnoc does.
+  int homotopy_retries = 4;
   /// `intermediate_tol` >= 0: IPOPT tol of the NLPs with sigma > 10 complementarity_tol (they
   /// only have to be good starting points for the next NLP); the later NLPs, and one that
   /// already meets complementarity_tol, are solved to ipopt.tol. 0: ipopt.tol for every NLP.

@@ -35,6 +35,9 @@ struct HomotopyRow {
   bool active_set_fixed = false;
   /// > 0: that re-solve pinned this many sliding exits (DiscretizationOptions::pin_sliding_exits).
   int pinned_exits = 0;
+  /// The NLP failed and its point was discarded: the homotopy went back to the last converged
+  /// NLP and took a smaller sigma step (HomotopyOptions::homotopy_retries).
+  bool retried = false;
 };
 
 /// A detected switch: the active set changes at an element boundary.

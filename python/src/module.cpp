@@ -146,6 +146,7 @@ py::dict homotopy_row(const fesd::HomotopyRow& r) {
   d["factorizations"] = r.factorizations;
   d["active_set_fixed"] = r.active_set_fixed;
   d["pinned_exits"] = r.pinned_exits;
+  d["retried"] = r.retried;
   return d;
 }
 

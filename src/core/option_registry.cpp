@@ -360,6 +360,10 @@ std::vector<Option> build() {
   o.push_back(scalar<&T::homotopy, &H::max_homotopy_steps>(
       kHom, "N_homotopy", kBoth, "maximum number of NLPs per step or OCP", "N_homotopy",
       between(0, 1000, "(0: automatic)")));
+  o.push_back(scalar<&T::homotopy, &H::homotopy_retries>(
+      kHom, "homotopy_retries", Use::Ocp,
+      "failed NLPs retried from the last converged one with a smaller sigma step", "",
+      between(0, 100, "(0: go on from the failed point)")));
   o.push_back(scalar<&T::homotopy, &H::intermediate_tol>(
       kHom, "intermediate_tol", kBoth, "IPOPT tol of the NLPs with sigma > 10 complementarity_tol",
       "", Range{.min = 0, .note = "(0: ipopt.tol everywhere)"}));

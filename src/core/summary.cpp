@@ -30,6 +30,7 @@ std::string format_homotopy_row(const HomotopyRow& r) {
                ? fmt::format("  (the last NLP again, active set fixed, {} sliding exit{} pinned)",
                              r.pinned_exits, r.pinned_exits == 1 ? "" : "s")
                : std::string("  (the last NLP again, active set fixed)");
+  if (r.retried) row += "  (failed: retried from the last converged NLP, smaller sigma step)";
   return row + "\n";
 }
 

@@ -800,8 +800,12 @@ class Integrator {
 
   mpcc::HomotopyResult homotopy(StepProblem& sp, const HomotopyOptions& hopt,
                                 std::vector<HomotopyRow>& rows) {
+    // A failed step goes through the retry policy of step(), not through homotopy retries
+    // (homotopy_retries is an optimal-control option).
+    HomotopyOptions h = hopt;
+    h.homotopy_retries = 0;
     mpcc::HomotopyResult hr =
-        sp.mpcc.solve_homotopy(solver(), hopt, {}, mpcc::kStepWarmMaxIter, early_finish(sp, hopt));
+        sp.mpcc.solve_homotopy(solver(), h, {}, mpcc::kStepWarmMaxIter, early_finish(sp, h));
     account(hr, rows);
     return hr;
   }

@@ -182,6 +182,9 @@ IntegratorResult integrate(const Pds& model, const Eigen::VectorXd& x0, double T
   res.x.push_back(x0);
   Eigen::VectorXd x = x0;
   double t = 0;
+  // homotopy_retries is an optimal-control option: a failed step goes to the fallback solver.
+  HomotopyOptions step_homotopy = options.homotopy;
+  step_homotopy.homotopy_retries = 0;
   for (int step = 0; step < N_sim; ++step) {
     mpcc.fix(in.s0, x);
     const StepGuess g = projected_euler(model, tab, iv.N_FE(), T_step, x, u, p);
@@ -192,11 +195,11 @@ IntegratorResult integrate(const Pds& model, const Eigen::VectorXd& x0, double T
       res.summary.n_constraints = mpcc.num_constraints();
       res.summary.setup_s = seconds_since(t_start);
     }
-    mpcc::HomotopyResult hr = mpcc.solve_homotopy(*solver, options.homotopy);
+    mpcc::HomotopyResult hr = mpcc.solve_homotopy(*solver, step_homotopy);
     nlp::NlpSolver* step_nlp_solver = solver.get();
     if (hr.status != Status::Success) {
       if (!fallback_solver) fallback_solver = nlp::make_solver(options.nlp);
-      mpcc::HomotopyResult again = mpcc.solve_homotopy(*fallback_solver, options.homotopy);
+      mpcc::HomotopyResult again = mpcc.solve_homotopy(*fallback_solver, step_homotopy);
       if (again.status == Status::Success) ++res.summary.fallback_steps;
       mpcc::append(hr, again);
       hr.status = again.status;

@@ -141,7 +141,8 @@ json homotopy_row(const HomotopyRow& r) {
               {"factor_s", number(r.factor_s)},
               {"factorizations", r.factorizations},
               {"active_set_fixed", r.active_set_fixed},
-              {"pinned_exits", r.pinned_exits}};
+              {"pinned_exits", r.pinned_exits},
+              {"retried", r.retried}};
 }
 
 json homotopy(const std::vector<std::vector<HomotopyRow>>& steps) {

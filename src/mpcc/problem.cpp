@@ -144,11 +144,19 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
   it_ = nlp::Iterate{};
   it_.x = nlp_.x_init;
   double sigma = o.sigma_0;
+  // The schedule's sigma that the homotopy is heading to: sigma itself, or (after a retry) a
+  // sigma the failed step is being approached by in smaller steps.
+  double target = sigma;
+  // The last converged NLP's point and sigma: where a failed NLP is retried from.
+  std::optional<nlp::Iterate> good;
+  double sigma_good = 0;
+  int retries = 0;
   bool last_ok = false, eval_failed = false;
   bool tight_now = false;  // solve the next NLP with the configured tolerance
   const int max_steps = homotopy_length(o);
-  // One NLP more than max_steps if the last one met the tolerance only loosely (below).
-  for (int k = 0; k < max_steps + (tight_now ? 1 : 0); ++k) {
+  // One NLP more than max_steps if the last one met the tolerance only loosely (below), and one
+  // more per retry.
+  for (int k = 0; k < max_steps + (tight_now ? 1 : 0) + retries; ++k) {
     apply_sigma(*relaxation_, nlp_, it_, sigma);
     // NLPs far from the end of the homotopy only need to be good starting points for the next
     // one: with intermediate_tol they stop earlier. The NLPs with sigma near
@@ -160,10 +168,24 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
                      k > 0 ? warm_max_iter : 0);
     res.comp_residual = comp_residual(it_.x.data(), residual_pairs_);
     record(res, r, static_cast<int>(res.rows.size()), sigma);
-    if (on_row) on_row(res.rows.back());
     sigma_ = sigma;
     last_ok = r.success;
     eval_failed = r.eval_error;
+    if (!last_ok && good && retries < o.homotopy_retries) {
+      // A failed NLP after a converged one: back to that NLP's point, and a sigma step of half
+      // the logarithm (sigma_good * sqrt(sigma / sigma_good)) towards the same target.
+      res.rows.back().retried = true;
+      if (on_row) on_row(res.rows.back());
+      ++retries;
+      it_ = *good;
+      sigma = std::sqrt(sigma_good * sigma);
+      continue;
+    }
+    if (on_row) on_row(res.rows.back());
+    if (last_ok) {
+      good = it_;
+      sigma_good = sigma;
+    }
     if (last_ok && res.comp_residual <= o.complementarity_tol) {
       if (!loose) break;
       // Complementarity already met by a loosely solved NLP: solve it again at this sigma with
@@ -179,7 +201,9 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
         return res;
       }
     }
-    sigma = std::max(o.homotopy_update_slope * sigma, o.sigma_N);
+    // After a smaller step that converged, the step to the target; after that, the schedule's.
+    if (sigma <= target) target = std::max(o.homotopy_update_slope * sigma, o.sigma_N);
+    sigma = target;
   }
   next_row_ = static_cast<int>(res.rows.size());
   res.status = final_status(last_ok, eval_failed, res.comp_residual, o.complementarity_tol);

@@ -2,9 +2,11 @@
 // on a two-variable MPCC with a known solution, through the integrator on Example 3(a), and the
 // rules every mode keeps: two-sided groups stay Scholtes rows, Fischer-Burmeister needs groups
 // with a common factor.
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -199,6 +201,102 @@ TEST(SolveAgain, ChangesBoundsForOneNlpAndKeepsThePointIfItFails) {
   EXPECT_EQ(infeasible.rows[0].k, k_next + 1);
   EXPECT_EQ(p.problem.solution(), before);
   bounds_kept();
+}
+
+// ---- homotopy_retries -------------------------------------------------------------------------
+
+/// IPOPT, except that the NLPs numbered in `fail` (0-based calls) report a failure and leave a
+/// useless point (x = y = 5) behind, as a locally infeasible NLP does.
+class FailingSolver : public fesd::nlp::NlpSolver {
+ public:
+  explicit FailingSolver(std::vector<int> fail) : fail_(std::move(fail)) {}
+  fesd::nlp::NlpResult solve(const fesd::nlp::BlockNlp& nlp, fesd::nlp::Iterate& start,
+                             bool warm_start, double tol, int max_iter) override {
+    starts.push_back(start.x);
+    const int call = calls_++;
+    if (std::find(fail_.begin(), fail_.end(), call) == fail_.end())
+      return inner_->solve(nlp, start, warm_start, tol, max_iter);
+    std::fill(start.x.begin(), start.x.end(), 5.0);
+    fesd::nlp::NlpResult r;
+    r.status = "Infeasible_Problem_Detected";
+    return r;
+  }
+  std::vector<std::vector<double>> starts;  ///< the primal start of every call
+
+ private:
+  std::vector<int> fail_;
+  int calls_ = 0;
+  std::unique_ptr<fesd::nlp::NlpSolver> inner_ = fesd::nlp::make_solver(fesd::NlpOptions{});
+};
+
+std::vector<double> sigmas(const fesd::mpcc::HomotopyResult& res) {
+  std::vector<double> s;
+  for (const fesd::HomotopyRow& r : res.rows) s.push_back(r.sigma);
+  return s;
+}
+
+// sigma_0 = 0.1, slope 0.1; the third NLP (sigma = 1e-3) fails. With retries the homotopy goes
+// back to the point of sigma = 1e-2, solves at sqrt(1e-2 * 1e-3), then at 1e-3 again and on; the
+// retried row is marked and the result is the MPCC's solution (1, 0). Without, it goes on from the
+// failed point.
+TEST(HomotopyRetries, FailedNlpIsSolvedAgainFromTheLastConvergedOne) {
+  fesd::HomotopyOptions options;
+  options.sigma_0 = 0.1;
+  options.homotopy_retries = 4;
+  TinyProblem p(1.0);
+  FailingSolver solver({2});
+  const auto res = p.problem.solve_homotopy(solver, options);
+  ASSERT_EQ(res.status, fesd::Status::Success) << res.last_nlp_status;
+  const std::vector<double> s = sigmas(res);
+  ASSERT_GE(s.size(), 6u);
+  EXPECT_NEAR(s[2], 1e-3, 1e-18);
+  EXPECT_TRUE(res.rows[2].retried);
+  EXPECT_NEAR(s[3], std::pow(10.0, -2.5), 1e-17);
+  EXPECT_NEAR(s[4], 1e-3, 1e-18);
+  EXPECT_NEAR(s[5], 1e-4, 1e-19);
+  for (std::size_t k = 0; k < res.rows.size(); ++k) {
+    if (k != 2) {
+      EXPECT_FALSE(res.rows[k].retried) << "row " << k;
+    }
+  }
+  // The retry starts from the point of sigma = 1e-2, not from the failed one.
+  EXPECT_EQ(solver.starts[3][p.x], solver.starts[2][p.x]);
+  EXPECT_NEAR(p.at(p.x), 1.0, 1e-6);
+  EXPECT_NEAR(p.at(p.y), 0.0, 1e-6);
+
+  options.homotopy_retries = 0;
+  TinyProblem q(1.0);
+  FailingSolver plain({2});
+  const auto res0 = q.problem.solve_homotopy(plain, options);
+  const std::vector<double> s0 = sigmas(res0);
+  ASSERT_GE(s0.size(), 4u);
+  EXPECT_NEAR(s0[3], 1e-4, 1e-19);
+  EXPECT_FALSE(res0.rows[2].retried);
+  EXPECT_EQ(plain.starts[3][q.x], 5.0);  // on from the failed point
+}
+
+// Every NLP after the first fails: at most homotopy_retries retries, each halving the logarithmic
+// step from the converged sigma = 1, then the homotopy goes on (and fails).
+TEST(HomotopyRetries, AtMostTheConfiguredNumber) {
+  fesd::HomotopyOptions options;
+  options.sigma_0 = 1.0;
+  options.homotopy_retries = 3;
+  TinyProblem p(1.0);
+  FailingSolver solver({1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19});
+  const auto res = p.problem.solve_homotopy(solver, options);
+  EXPECT_EQ(res.status, fesd::Status::NlpFailed);
+  const std::vector<double> s = sigmas(res);
+  ASSERT_GE(s.size(), 6u);
+  EXPECT_NEAR(s[1], 0.1, 1e-16);
+  EXPECT_NEAR(s[2], std::pow(10.0, -0.5), 1e-15);
+  EXPECT_NEAR(s[3], std::pow(10.0, -0.25), 1e-15);
+  EXPECT_NEAR(s[4], std::pow(10.0, -0.125), 1e-15);
+  EXPECT_NEAR(s[5], 0.1, 1e-16);  // budget spent: on to the schedule's sigma
+  int retried = 0;
+  for (const fesd::HomotopyRow& r : res.rows) retried += r.retried ? 1 : 0;
+  EXPECT_EQ(retried, 3);
+  // The schedule's 13 NLPs (sigma = 1 .. 1e-12) plus the three retries.
+  EXPECT_EQ(s.size(), 16u);
 }
 
 // ---- Example 3(a) through the integrator ------------------------------------------------------
