@@ -154,9 +154,12 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
   bool last_ok = false, eval_failed = false;
   bool tight_now = false;  // solve the next NLP with the configured tolerance
   const int max_steps = homotopy_length(o);
-  // One NLP more than max_steps if the last one met the tolerance only loosely (below), and one
-  // more per retry.
-  for (int k = 0; k < max_steps + (tight_now ? 1 : 0) + retries; ++k) {
+  // NLPs at the schedule's sigma (not retried) count towards max_steps; the retried NLPs and the
+  // smaller steps after them (at most 2 homotopy_retries) do not. One NLP more than max_steps if
+  // the last one met the tolerance only loosely (below).
+  for (int scheduled = 0; scheduled < max_steps + (tight_now ? 1 : 0);) {
+    const int k = static_cast<int>(res.rows.size());
+    const bool on_schedule = sigma == target;
     apply_sigma(*relaxation_, nlp_, it_, sigma);
     // NLPs far from the end of the homotopy only need to be good starting points for the next
     // one: with intermediate_tol they stop earlier. The NLPs with sigma near
@@ -167,7 +170,7 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
         solver.solve(nlp_, it_, /*warm_start=*/k > 0, loose ? o.intermediate_tol : 0.0,
                      k > 0 ? warm_max_iter : 0);
     res.comp_residual = comp_residual(it_.x.data(), residual_pairs_);
-    record(res, r, static_cast<int>(res.rows.size()), sigma);
+    record(res, r, k, sigma);
     sigma_ = sigma;
     last_ok = r.success;
     eval_failed = r.eval_error;
@@ -182,6 +185,7 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
       continue;
     }
     if (on_row) on_row(res.rows.back());
+    if (on_schedule) ++scheduled;
     if (last_ok) {
       good = it_;
       sigma_good = sigma;

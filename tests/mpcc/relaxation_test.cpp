@@ -295,8 +295,10 @@ TEST(HomotopyRetries, AtMostTheConfiguredNumber) {
   int retried = 0;
   for (const fesd::HomotopyRow& r : res.rows) retried += r.retried ? 1 : 0;
   EXPECT_EQ(retried, 3);
-  // The schedule's 13 NLPs (sigma = 1 .. 1e-12) plus the three retries.
-  EXPECT_EQ(s.size(), 16u);
+  // The schedule's 13 NLPs (sigma = 1 .. 1e-12) plus the three retried NLPs and the smaller step
+  // after the last: those do not count towards N_homotopy.
+  EXPECT_EQ(s.size(), 17u);
+  EXPECT_NEAR(s.back(), 1e-12, 1e-24);
 }
 
 // ---- Example 3(a) through the integrator ------------------------------------------------------
