@@ -142,11 +142,13 @@ struct HomotopyOptions {
   /// reach sigma_N, ceil(log(sigma_N / sigma_0) / log(slope)) + 1 (13 with the defaults).
   int max_homotopy_steps = 0;
   /// `homotopy_retries` 0..100 (optimal control; an integration step has its own retry policy and
-  /// ignores it): an NLP that fails after a converged one is discarded and the
+  /// ignores it): an NLP that fails after a converged one at a point that violates the
+  /// constraints (primal infeasibility > 1e-6, or failed evaluations) is discarded and the
   /// homotopy goes back to the converged NLP's point with half the logarithmic sigma step
   /// (sigma = sqrt(sigma_good * sigma_failed)), then on to the failed sigma; at most this many
-  /// times per homotopy (each retry is one NLP more than N_homotopy). 0: go on from the failed
-  /// point, as nosnoc does.
+  /// times per homotopy (the retried NLPs and the smaller steps after them do not count towards
+  /// N_homotopy). A failed NLP that ends feasible (e.g. at max_iter) is kept, and so is every
+  /// failed NLP with 0: the homotopy goes on from its point, as nosnoc's does.
   int homotopy_retries = 4;
   /// `intermediate_tol` >= 0: IPOPT tol of the NLPs with sigma > 10 complementarity_tol (they
   /// only have to be good starting points for the next NLP); the later NLPs, and one that

@@ -210,15 +210,13 @@ IntegratorResult integrate(const Pds& model, const Eigen::VectorXd& x0, double T
     if (hr.status == Status::Success && d.use_fesd && options.homotopy.fix_active_set) {
       mpcc::HomotopyResult again = mpcc.solve_again(*step_nlp_solver, options.homotopy,
                                                     iv.active_set_bounds(mpcc.solution().data()));
-      const Status homotopy_status = hr.status;
-      mpcc::append(hr, again);
       if (again.status == Status::Success) {
+        mpcc::append(hr, again);
         ++res.summary.active_set_solves;
         hr.active_set_fixed = true;
       } else {
+        mpcc::append_discarded(hr, again);  // the homotopy's point, residual and status stay
         ++res.summary.active_set_failures;
-        hr.status = homotopy_status;
-        hr.comp_residual = mpcc::comp_residual(mpcc.solution().data(), iv.residual_pairs());
       }
     }
     ++res.summary.homotopy_path_steps;

@@ -89,6 +89,11 @@ class Problem {
   /// `s_elastic_max`, `s_elastic_0`: bounds [0, s_elastic_max] and guess of the elastic variable
   /// (elastic modes; HomotopyOptions).
   void relax(MpccMode mode, double s_elastic_max = nlp::kInf, double s_elastic_0 = 0.0);
+  /// relax() in the options' mpcc_mode with their elastic variable (s_elastic_max, s_elastic_0):
+  /// the optimal-control solvers.
+  void relax(const HomotopyOptions& options) {
+    relax(options.mpcc_mode, options.s_elastic_max, options.s_elastic_0);
+  }
   /// Builds the sparsity of the NLP, probed at the current guess. After relax().
   void finalize();
   bool finalized() const { return nlp_.finalized(); }

@@ -129,7 +129,7 @@ std::unique_ptr<OcpNlp> build(const Ocp& ocp, const OcpOptions& o, const StagePa
     for (const auto& iv : b->iv) clock_end.push_back(iv->x(iv->N_FE(), ocp.clock_state));
   ocp_detail::add_speed_of_time_constraints(mp, ocp, b->p_k, clock_end);
   for (const auto& iv : b->iv) mp.add_complementarity(iv->groups(), iv->residual_pairs());
-  mp.relax(o.homotopy.mpcc_mode, o.homotopy.s_elastic_max, o.homotopy.s_elastic_0);
+  mp.relax(o.homotopy);
   return b;
 }
 

@@ -56,7 +56,7 @@ std::unique_ptr<PdsOcpNlp> build(const PdsOcp& ocp, const OcpOptions& o,
   ocp_detail::add_ocp_terms(mp, ocp, o, b->tab, m.n_x(), m.n_u(), b->s0, b->p_k, b->q, b->iv,
                             b->terminal_slacks, b->comp_points);
   for (const auto& iv : b->iv) mp.add_complementarity(iv->groups(), iv->residual_pairs());
-  mp.relax(o.homotopy.mpcc_mode, o.homotopy.s_elastic_max, o.homotopy.s_elastic_0);
+  mp.relax(o.homotopy);
   return b;
 }
 

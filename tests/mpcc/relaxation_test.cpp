@@ -206,10 +206,12 @@ TEST(SolveAgain, ChangesBoundsForOneNlpAndKeepsThePointIfItFails) {
 // ---- homotopy_retries -------------------------------------------------------------------------
 
 /// IPOPT, except that the NLPs numbered in `fail` (0-based calls) report a failure and leave a
-/// useless point (x = y = 5) behind, as a locally infeasible NLP does.
+/// useless point (x = y = 5) behind, as a locally infeasible NLP does (reported primal
+/// infeasibility `inf_pr`).
 class FailingSolver : public fesd::nlp::NlpSolver {
  public:
-  explicit FailingSolver(std::vector<int> fail) : fail_(std::move(fail)) {}
+  explicit FailingSolver(std::vector<int> fail, double inf_pr = 1.0)
+      : fail_(std::move(fail)), inf_pr_(inf_pr) {}
   fesd::nlp::NlpResult solve(const fesd::nlp::BlockNlp& nlp, fesd::nlp::Iterate& start,
                              bool warm_start, double tol, int max_iter) override {
     starts.push_back(start.x);
@@ -219,12 +221,14 @@ class FailingSolver : public fesd::nlp::NlpSolver {
     std::fill(start.x.begin(), start.x.end(), 5.0);
     fesd::nlp::NlpResult r;
     r.status = "Infeasible_Problem_Detected";
+    r.inf_pr = inf_pr_;
     return r;
   }
   std::vector<std::vector<double>> starts;  ///< the primal start of every call
 
  private:
   std::vector<int> fail_;
+  double inf_pr_ = 1.0;
   int calls_ = 0;
   std::unique_ptr<fesd::nlp::NlpSolver> inner_ = fesd::nlp::make_solver(fesd::NlpOptions{});
 };
@@ -273,6 +277,15 @@ TEST(HomotopyRetries, FailedNlpIsSolvedAgainFromTheLastConvergedOne) {
   EXPECT_NEAR(s0[3], 1e-4, 1e-19);
   EXPECT_FALSE(res0.rows[2].retried);
   EXPECT_EQ(plain.starts[3][q.x], 5.0);  // on from the failed point
+
+  // A failed NLP whose point satisfies the constraints (reported inf_pr 1e-9) is kept too.
+  options.homotopy_retries = 4;
+  TinyProblem f(1.0);
+  FailingSolver feasible({2}, 1e-9);
+  const auto res_f = f.problem.solve_homotopy(feasible, options);
+  ASSERT_GE(res_f.rows.size(), 4u);
+  EXPECT_FALSE(res_f.rows[2].retried);
+  EXPECT_NEAR(res_f.rows[3].sigma, 1e-4, 1e-19);
 }
 
 // Every NLP after the first fails: at most homotopy_retries retries, each halving the logarithmic
