@@ -377,8 +377,8 @@ def fig_sliding_mode():
 
 # ---- row 29: the hysteresis car ---------------------------------------------------------------
 def fig_hysteresis_car():
-    # The file selects MUMPS (with sparse_ldl the run ends nlp_failed: docs/nosnoc-examples.md,
-    # row 29).
+    # One NLP fails with fesd's sparse_ldl and is retried (homotopy_retries): docs/nosnoc-examples.md,
+    # row 29.
     d = run("solve", "hysteresis_car_control_time_optimal")
     t, x = boundaries(d), arr(d, "x")
     names = ["q (position)", "v (speed)", "L (fuel)", "w (auxiliary)", "t (time)"]
