@@ -183,7 +183,9 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
     // point of the relaxed problem, and the homotopy goes on from it; one that does not is no
     // start for the next sigma.
     const bool unusable = r.eval_error || !(r.inf_pr <= kFeasibleFailure);
-    if (!last_ok && unusable && good && retries < o.homotopy_retries) {
+    // (Only after a sigma step: the tight re-solve at a loosely converged NLP's sigma has none
+    // to make smaller.)
+    if (!last_ok && unusable && good && sigma < sigma_good && retries < o.homotopy_retries) {
       // Back to the last converged NLP's point, and a sigma step of half the logarithm
       // (sigma_good * sqrt(sigma / sigma_good)) towards the same target.
       res.rows.back().retried = true;
