@@ -75,6 +75,7 @@ fesd::OcpResult make_result() {
   r.homotopy = {
       fesd::HomotopyRow{0, 1.0, 0.5, 2.0, 1e-12, 7, "Solve_Succeeded", 0.001, "mumps"},
       fesd::HomotopyRow{1, 0.1, 1e-10, 1.25, 2e-13, 3, "Solve_Succeeded", 0.002, "mumps"}};
+  r.homotopy[0].retried = true;
   r.summary.homotopy_steps = 2;
   r.summary.nlp_iterations = 10;
   r.summary.n_variables = 100;
@@ -140,6 +141,8 @@ TEST(WriteOcpJson, KeysInOrderAndValues) {
   ASSERT_EQ(j["homotopy"].size(), 2u);
   EXPECT_EQ(j["homotopy"][1]["sigma"].get<double>(), 0.1);
   EXPECT_EQ(j["homotopy"][1]["nlp_status"], "Solve_Succeeded");
+  EXPECT_EQ(j["homotopy"][0]["retried"], true);
+  EXPECT_EQ(j["homotopy"][1]["retried"], false);
   const auto& stats = j["stats"];
   EXPECT_EQ(stats["homotopy_steps"], 2);
   EXPECT_EQ(stats["nlp_iterations"], 10);
