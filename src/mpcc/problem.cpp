@@ -197,7 +197,7 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
     }
     if (on_row) on_row(res.rows.back());
     if (on_schedule) ++scheduled;
-    if (last_ok) {
+    if (last_ok && o.homotopy_retries > 0) {  // (no copy when nothing can be retried)
       good = it_;
       sigma_good = sigma;
     }
