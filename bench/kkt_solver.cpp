@@ -267,7 +267,7 @@ struct Row {
   double s_per_iter = 0, factor_s_per_iter = 0, objective = NAN;
   long long factorizations = 0;
   double factor_s_per_call = NAN;  // fesd's module only (its own count)
-  long long solves = 0, refinements = 0, delayed = 0;
+  long long solves = 0, refinements = 0, delayed = 0, reorderings = 0, undone = 0;
   double solve_s_per_iter = NAN;
 };
 
@@ -364,6 +364,8 @@ int main(int argc, char** argv) {
         row.solves = after.solves - before.solves;
         row.refinements = after.refinement_steps - before.refinement_steps;
         row.delayed = after.delayed_pivots - before.delayed_pivots;
+        row.reorderings = after.reorderings - before.reorderings;
+        row.undone = after.reorderings_undone - before.reorderings_undone;
         row.solve_s_per_iter = (after.solve_seconds - before.solve_seconds) / it;
         for (int i = 0; i < module.captured_count(); ++i) {
           Matrix m;
@@ -391,10 +393,11 @@ int main(int argc, char** argv) {
       if (capture)
         fmt::print(
             "{:>20} solves {} ({:.3f} ms/iter), refinement steps {}, delayed pivots {:.1f} "
-            "per factorization\n",
+            "per factorization, re-orderings {} ({} undone)\n",
             "", row.solves, 1e3 * row.solve_s_per_iter, row.refinements,
             static_cast<double>(row.delayed) /
-                static_cast<double>(std::max(1LL, row.factorizations)));
+                static_cast<double>(std::max(1LL, row.factorizations)),
+            row.reorderings, row.undone);
       std::fflush(stdout);
       rows.push_back(row);
     }
@@ -427,13 +430,13 @@ int main(int argc, char** argv) {
     std::ofstream os(csv);
     os << "N_stages,solver,n_variables,n_constraints,kkt_rows,iterations,s_per_iteration,"
           "factor_s_per_iteration,factorizations,factor_s_per_call,solves,solve_s_per_iteration,"
-          "refinement_steps,delayed_pivots,objective,status\n";
+          "refinement_steps,delayed_pivots,reorderings,reorderings_undone,objective,status\n";
     for (const Row& r : rows)
-      os << fmt::format("{},{},{},{},{},{},{:.6g},{:.6g},{},{:.6g},{},{:.6g},{},{},{:.12g},{}\n",
-                        r.N_stages, r.solver, r.n_vars, r.n_cons, r.kkt_rows, r.iterations,
-                        r.s_per_iter, r.factor_s_per_iter, r.factorizations, r.factor_s_per_call,
-                        r.solves, r.solve_s_per_iter, r.refinements, r.delayed, r.objective,
-                        r.status);
+      os << fmt::format(
+          "{},{},{},{},{},{},{:.6g},{:.6g},{},{:.6g},{},{:.6g},{},{},{},{},{:.12g},{}\n",
+          r.N_stages, r.solver, r.n_vars, r.n_cons, r.kkt_rows, r.iterations, r.s_per_iter,
+          r.factor_s_per_iter, r.factorizations, r.factor_s_per_call, r.solves, r.solve_s_per_iter,
+          r.refinements, r.delayed, r.reorderings, r.undone, r.objective, r.status);
     os << "\nN_stages,kkt_rows,matrices,sparse_ldl_factor_s,mumps_factor_s\n";
     for (const Direct& d : direct)
       os << fmt::format("{},{},{},{:.6g},{:.6g}\n", d.N_stages, d.kkt_rows, d.matrices,
@@ -456,6 +459,8 @@ int main(int argc, char** argv) {
                            {"solve_s_per_iteration", r.solve_s_per_iter},
                            {"refinement_steps", r.refinements},
                            {"delayed_pivots", r.delayed},
+                           {"reorderings", r.reorderings},
+                           {"reorderings_undone", r.undone},
                            {"objective", r.objective},
                            {"status", r.status}});
     for (const Direct& d : direct)

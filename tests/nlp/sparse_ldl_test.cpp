@@ -15,6 +15,7 @@
 
 #include "../../bench/sliding_ocp.hpp"
 #include "fesd/ocp.hpp"
+#include "fesd/problem_file.hpp"
 #include "nlp/kkt/kkt_module.h"
 
 namespace {
@@ -308,6 +309,119 @@ TEST(SparseLdl, DelayedPivotsChangingBetweenFactorizationsOfOneStructure) {
     EXPECT_EQ(solver.solve(b), x1) << "trial " << trial;
   }
   EXPECT_GE(with_delays, 6);
+}
+
+FesdKktStats kkt_stats() {
+  FesdKktStats st{};
+  module().stats(&st);
+  return st;
+}
+
+/// Normwise backward error as backward_error(), from the triplets (no dense matrix).
+double sparse_backward_error(const Triplets& t, const Eigen::VectorXd& x,
+                             const Eigen::VectorXd& b) {
+  Eigen::VectorXd r = b, rowsum = Eigen::VectorXd::Zero(t.n);
+  for (int e = 0; e < t.nz(); ++e) {
+    const int i = t.irn[e] - 1, j = t.icn[e] - 1;
+    r[i] -= t.val[e] * x[j];
+    rowsum[i] += std::abs(t.val[e]);
+    if (i != j) {
+      r[j] -= t.val[e] * x[i];
+      rowsum[j] += std::abs(t.val[e]);
+    }
+  }
+  return r.lpNorm<Eigen::Infinity>() /
+         (rowsum.maxCoeff() * x.lpNorm<Eigen::Infinity>() + b.lpNorm<Eigen::Infinity>());
+}
+
+// From 5000 rows on, a matrix with fewer zero diagonals than the one the ordering was matched on
+// (IPOPT's first matrix of an NLP is often unperturbed: variables without curvature or bounds have
+// a zero diagonal, which the later, perturbed matrices do not) gets the ordering computed again
+// from its own values; the new ordering is kept if its factor has at most 0.8x the entries of the
+// factorization before it, else the old one comes back (sparse_ldl.cpp, kReorderZeroDrop,
+// kReorderKeep; docs/kkt-solver.md, "Hopper"). Never on more zeros, never below 5000 rows.
+struct ReorderRun {
+  long long reorders_first, reorders_second, reorders_third, undone, entries_unperturbed,
+      entries_second, entries_fourth, fresh_entries;
+  double berr;
+};
+ReorderRun reorder_run(int nx, int m, int zero_every) {
+  std::mt19937 rng(77);
+  Triplets perturbed = random_kkt(rng, nx, m, 0.0);
+  for (int i = 0; i < nx; ++i) perturbed.add(i, i, 3.0);  // delta_x
+  // Unperturbed: every zero_every-th variable without curvature or bound (diagonal exactly 0).
+  Triplets unperturbed = perturbed;
+  for (int e = 0; e < unperturbed.nz(); ++e) {
+    const int i = unperturbed.irn[e] - 1;
+    if (i == unperturbed.icn[e] - 1 && i < nx && i % zero_every == 0) unperturbed.val[e] = 0.0;
+  }
+  ReorderRun out{};
+  Ma27 solver(perturbed, FESD_KKT_SPARSE);
+  const FesdKktStats start = kkt_stats();
+  long long before = start.reorderings;
+  // The unperturbed matrices may be singular (IFLAG 3), as IPOPT's often are.
+  EXPECT_GE(solver.factor(unperturbed.val), 0);
+  out.entries_unperturbed = kkt_stats().last_factor_entries;
+  out.reorders_first = kkt_stats().reorderings - before;
+  before = kkt_stats().reorderings;
+  EXPECT_EQ(solver.factor(perturbed.val), 0);
+  out.reorders_second = kkt_stats().reorderings - before;
+  out.entries_second = kkt_stats().last_factor_entries;
+  const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(perturbed.n, -1, 2);
+  out.berr = sparse_backward_error(perturbed, solver.solve(b), b);
+  before = kkt_stats().reorderings;
+  EXPECT_GE(solver.factor(unperturbed.val), 0);  // more zeros again: the ordering stays
+  out.reorders_third = kkt_stats().reorderings - before;
+  EXPECT_EQ(solver.factor(perturbed.val), 0);
+  out.entries_fourth = kkt_stats().last_factor_entries;
+  EXPECT_LT(sparse_backward_error(perturbed, solver.solve(b), b), 1e-14);
+  out.undone = kkt_stats().reorderings_undone - start.reorderings_undone;
+  Ma27 fresh(perturbed, FESD_KKT_SPARSE);
+  EXPECT_EQ(fresh.factor(perturbed.val), 0);
+  out.fresh_entries = kkt_stats().last_factor_entries;
+  return out;
+}
+
+TEST(SparseLdl, OrderingComputedAgainWhenFewerDiagonalsAreZeroUndoneIfNotSmaller) {
+  ASSERT_NE(module().stats, nullptr);
+  // Random KKT matrices: the ordering of the perturbed matrix has about the static factor size of
+  // the one matched on the unperturbed matrix (random coupling fills either way), so the
+  // re-ordering is undone before anything is factorized with it: every factor of the structure
+  // has the entries of the old ordering.
+  for (int every : {2, 3}) {
+    const ReorderRun r = reorder_run(3000, 2200, every);  // 5200 rows
+    EXPECT_EQ(r.reorders_first, 0) << every;
+    EXPECT_EQ(r.reorders_second, 1) << every;
+    EXPECT_EQ(r.undone, 1) << every;
+    EXPECT_EQ(r.reorders_third, 0) << every;  // not re-ordered again
+    EXPECT_EQ(r.entries_second, r.entries_fourth) << every;
+    EXPECT_LT(r.berr, 1e-14) << every;
+  }
+  const ReorderRun small = reorder_run(2500, 2000, 3);  // 4500 rows: never re-ordered
+  EXPECT_EQ(small.reorders_second, 0);
+  EXPECT_EQ(small.undone, 0);
+  EXPECT_LT(small.berr, 1e-14);
+}
+
+// The case the re-ordering is for: nosnoc_py's hopper OCP (examples/nosnoc/hopper_ocp.toml, 25567
+// KKT rows). NLP 1's structure is matched on an unperturbed matrix; its first perturbed matrix
+// has fewer zero diagonals and an ordering with 0.69x the static factor entries (measured:
+// 1.96e6 -> 1.35e6), which is kept. 15 IPOPT iterations per NLP are enough to get there.
+TEST(SparseLdl, HopperOcpKeepsTheOrderingOfItsPerturbedMatrices) {
+  ASSERT_NE(module().stats, nullptr);
+  fesd::OcpProblem p =
+      fesd::load_ocp_problem(std::string(FESD_SOURCE_DIR) + "/examples/nosnoc/hopper_ocp.toml");
+  p.options.homotopy.max_homotopy_steps = 2;
+  p.options.homotopy.homotopy_retries = 0;
+  p.options.nlp.max_iter = 15;
+  p.options.nlp.kkt_solver = fesd::KktSolver::SparseLdl;
+  const FesdKktStats before = kkt_stats();
+  const fesd::OcpResult r = fesd::solve(p.ocp, p.options);
+  const FesdKktStats after = kkt_stats();
+  ASSERT_EQ(r.homotopy.size(), 2U) << r.message;
+  EXPECT_EQ(r.homotopy[1].linear_solver, "sparse_ldl");
+  EXPECT_GE(after.reorderings - before.reorderings, 1);
+  EXPECT_EQ(after.reorderings_undone - before.reorderings_undone, 0);
 }
 
 TEST(SparseLdl, TwoStructuresAliveAtOnce) {

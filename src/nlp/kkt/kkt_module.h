@@ -20,8 +20,8 @@ enum FesdKktMode {
 void fesd_kkt_request_mode(int mode);
 
 /* Cumulative counters of this thread's ma27bd_ calls that ran the sparse factorization:
- * number of calls, thread CPU seconds in them, delayed pivots, and the last matrix's order and
- * entries of the factor. */
+ * number of calls, thread CPU seconds in them, delayed pivots, re-orderings, and the last
+ * matrix's order and entries of the factor. */
 struct FesdKktStats {
   long long factorizations;
   double factor_seconds;
@@ -31,6 +31,8 @@ struct FesdKktStats {
   long long refinement_steps;
   int last_n;
   long long last_factor_entries;
+  long long reorderings;         /* orderings computed again within a structure (sparse_ldl.cpp) */
+  long long reorderings_undone;  /* of them, undone: the factor was not smaller */
 };
 void fesd_kkt_stats(struct FesdKktStats* out);
 void fesd_kkt_reset_stats(void);

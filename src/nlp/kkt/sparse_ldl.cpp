@@ -77,6 +77,26 @@ constexpr int kLargeKktRows = 5000;
 /// A diagonal below this fraction of its row's largest entry makes a row "zero-diagonal" for the
 /// ordering's matching.
 constexpr double kZeroDiagRel = 1e-10;
+/// Re-ordering: from kLargeKktRows rows on, a factorization whose matrix has fewer zero-diagonal
+/// rows than the one the ordering was computed on, by more than 1 / kReorderZeroDrop of them,
+/// computes the ordering (matching and AMD) and the symbolic analysis again from its own values,
+/// at most kMaxReorders times per structure (MA27AD). Only the first kReorderChecks
+/// factorizations of a structure are checked: the count is a pass over the entries, ~10 % of a
+/// factorization of OCP (61) at N_stages 24. IPOPT's first matrix of an NLP is often an
+/// unperturbed one (delta_x = 0), where the variables without curvature or bounds have a zero
+/// diagonal; matched to constraint rows, they gave an ordering with 1.7x the factor entries and
+/// 2-4x the time per factorization for all the (perturbed) matrices after it on the hopper OCP
+/// (docs/kkt-solver.md, "Hopper: orderings from unperturbed matrices").
+/// The new ordering is kept only if its symbolic analysis has at most kReorderKeep times the
+/// factor entries (static fronts, no delayed pivots) of the old one; otherwise the old ordering
+/// (saved in IKEEP[N..2N)) comes back before anything is factorized and the structure is not
+/// re-ordered again. Measured in docs/kkt-solver.md ("Hopper"): on the hopper the new ordering
+/// has well under 0.8x the entries; on OCP (61) at N_stages 24 about the same entries and then
+/// 1.5-2x the delayed pivots of the first ordering (+10 % time per factorization) when kept.
+constexpr int kReorderZeroDrop = 20;
+constexpr int kMaxReorders = 4;
+constexpr int kReorderChecks = 10;
+constexpr double kReorderKeep = 0.8;
 /// Threshold pivoting: u = clamp(CNTL(1), kMinPivtol, kMaxPivtol).
 constexpr double kMinPivtol = 1e-8;
 constexpr double kMaxPivtol = 0.5;
@@ -129,7 +149,13 @@ enum KeepSlot {
   kKLa,
   kKAAddrLo,
   kKAAddrHi,
-  kKScaleSlots
+  kKScaleSlots,
+  kKOrderZeros = kKScaleSlots,  // zero-diagonal rows of the matrix the ordering was computed on
+  kKReorders,                   // orderings computed again since MA27AD (kReorderZeroDrop)
+  kKFactorizations,             // factorizations since MA27AD, counted up to kReorderChecks
+  kKStaticEntries,              // factor entries of the symbolic analysis in IW (static fronts)
+  kKCompare,                    // 1: the ordering is new, compare with kKStaticEntries
+  kKOrderSlots
 };
 
 /// The structure-only part of the factorization, computed once per structure and kept in IW:
@@ -203,6 +229,17 @@ Symbolic symbolic_view(const int* iw) {
   return v;
 }
 
+/// Entries of L for the symbolic analysis in IW without delayed pivots: per supernode its static
+/// front's rows times its columns.
+Index static_factor_entries(const int* iw) {
+  const Symbolic sym = symbolic_view(iw);
+  Index entries = 0;
+  for (int s = 0; s < sym.ns; ++s)
+    entries +=
+        static_cast<Index>(sym.fptr[s + 1] - sym.fptr[s]) * (sym.cols_ptr[s + 1] - sym.cols_ptr[s]);
+  return entries;
+}
+
 bool valid(int n, int i, int j) {
   return i >= 0 && i < n && j >= 0 && j < n;
 }
@@ -239,6 +276,28 @@ void pattern_columns(int n, int nz, const int* irn, const int* icn, const std::v
     if (!valid(n, i, j) || id[i] == id[j]) continue;
     rows[next[id[j]]++] = id[i];
   }
+}
+
+/// Rows whose diagonal is at most kZeroDiagRel of their row's largest off-diagonal entry: the rows
+/// the ordering matches. diag and rowmax are scratch.
+int count_zero_diagonal(int n, int nz, const int* irn, const int* icn, const double* a,
+                        std::vector<double>& diag, std::vector<double>& rowmax) {
+  diag.assign(n, 0.0);
+  rowmax.assign(n, 0.0);
+  for (int e = 0; e < nz; ++e) {
+    const int i = irn[e] - 1, j = icn[e] - 1;
+    if (!valid(n, i, j)) continue;
+    if (i == j) {
+      diag[i] += a[e];
+    } else {
+      rowmax[i] = std::max(rowmax[i], std::abs(a[e]));
+      rowmax[j] = std::max(rowmax[j], std::abs(a[e]));
+    }
+  }
+  int zeros = 0;
+  for (int i = 0; i < n; ++i)
+    if (rowmax[i] != 0.0 && std::abs(diag[i]) <= kZeroDiagRel * rowmax[i]) ++zeros;
+  return zeros;
 }
 
 /// The value-based ordering (see the file comment): zero-diagonal rows matched to a neighbour,
@@ -759,7 +818,7 @@ struct Contribution {
 /// ~3000-row KKT matrix: glibc returned the freed memory to the kernel and the next call paid
 /// page faults again.
 struct Workspace {
-  std::vector<double> rmax, cval, front[2], w1, w2;
+  std::vector<double> rmax, diag, cval, front[2], w1, w2;
   std::vector<int> fidx, kind, lp;
   std::vector<Contribution> cb;
   std::vector<std::vector<double>> pool;
@@ -1148,8 +1207,23 @@ FESD_KKT_KERNEL void sparse_factor(int n, int nz, const int* irn, const int* icn
   int* keep = n > 0 ? ikeep + 2 * n : nullptr;
   const auto addr = reinterpret_cast<std::uintptr_t>(iw);
   const int addr_lo = static_cast<int>(addr & 0x7fffffffU), addr_hi = static_cast<int>(addr >> 31);
-  const bool cached = n >= kKSlots && keep[kKOrdering] == kOrderingReady && keep[kKSymbolic] == 1 &&
-                      keep[kKLiw] == liw && keep[kKAddrLo] == addr_lo &&
+  Workspace& ws = thread_workspace();
+  bool reorder = false;
+  if (n >= kLargeKktRows && n >= kKOrderSlots && keep[kKOrdering] == kOrderingReady &&
+      keep[kKFactorizations] < kReorderChecks && keep[kKReorders] < kMaxReorders) {
+    ++keep[kKFactorizations];
+    const int zeros = count_zero_diagonal(n, nz, irn, icn, a, ws.diag, ws.rmax);
+    if (zeros < keep[kKOrderZeros] - keep[kKOrderZeros] / kReorderZeroDrop) {
+      std::copy_n(ikeep, n, ikeep + n);  // the old ordering, restored if the new one is worse
+      keep[kKCompare] = 1;
+      keep[kKOrdering] = kOrderingPending;
+      ++keep[kKReorders];
+      reorder = true;
+      if (stats != nullptr) ++stats->reorderings;
+    }
+  }
+  const bool cached = !reorder && n >= kKSlots && keep[kKOrdering] == kOrderingReady &&
+                      keep[kKSymbolic] == 1 && keep[kKLiw] == liw && keep[kKAddrLo] == addr_lo &&
                       keep[kKAddrHi] == addr_hi && iw[kHMagic] == kMagic && iw[kHN] == n &&
                       iw[kHNz] == nz;
   if (!cached) {
@@ -1171,8 +1245,26 @@ FESD_KKT_KERNEL void sparse_factor(int n, int nz, const int* irn, const int* icn
     if (keep[kKOrdering] != kOrderingReady) {
       compute_ordering(n, nz, irn, icn, a, ikeep);
       keep[kKOrdering] = kOrderingReady;
+      if (n >= kLargeKktRows && n >= kKOrderSlots)
+        keep[kKOrderZeros] = count_zero_diagonal(n, nz, irn, icn, a, ws.diag, ws.rmax);
     }
-    const Index end = build_symbolic(n, nz, irn, icn, ikeep, iw, pattern_end, liw);
+    Index end = build_symbolic(n, nz, irn, icn, ikeep, iw, pattern_end, liw);
+    if (end <= liw && n >= kLargeKktRows && n >= kKOrderSlots) {
+      const Index entries = static_factor_entries(iw);
+      if (keep[kKCompare] == 1) {
+        keep[kKCompare] = 0;
+        if (static_cast<double>(entries) >
+            kReorderKeep * static_cast<double>(keep[kKStaticEntries])) {
+          std::copy_n(ikeep + n, n, ikeep);  // not smaller: the old ordering, for good
+          keep[kKReorders] = kMaxReorders;
+          if (stats != nullptr) ++stats->reorderings_undone;
+          end = build_symbolic(n, nz, irn, icn, ikeep, iw, pattern_end, liw);
+        }
+      }
+      if (end <= liw)
+        keep[kKStaticEntries] = static_cast<int>(
+            std::min<Index>(static_factor_entries(iw), std::numeric_limits<int>::max()));
+    }
     if (end > liw) {
       info[0] = -3;
       info[1] =
@@ -1202,7 +1294,6 @@ FESD_KKT_KERNEL void sparse_factor(int n, int nz, const int* irn, const int* icn
                     keep[kKScaled] == 1 && keep[kKLa] == la && keep[kKAAddrLo] == a_lo &&
                     keep[kKAAddrHi] == a_hi;
   if (!warm) std::fill_n(scale, n, 1.0);
-  Workspace& ws = thread_workspace();
   {
     std::vector<double>& rmax = ws.rmax;
     rmax.resize(n);
