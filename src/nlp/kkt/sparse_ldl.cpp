@@ -278,10 +278,9 @@ void pattern_columns(int n, int nz, const int* irn, const int* icn, const std::v
   }
 }
 
-/// Rows whose diagonal is at most kZeroDiagRel of their row's largest off-diagonal entry: the rows
-/// the ordering matches. diag and rowmax are scratch.
-int count_zero_diagonal(int n, int nz, const int* irn, const int* icn, const double* a,
-                        std::vector<double>& diag, std::vector<double>& rowmax) {
+/// Each row's diagonal (duplicates summed) and largest off-diagonal magnitude.
+void diagonal_and_row_max(int n, int nz, const int* irn, const int* icn, const double* a,
+                          std::vector<double>& diag, std::vector<double>& rowmax) {
   diag.assign(n, 0.0);
   rowmax.assign(n, 0.0);
   for (int e = 0; e < nz; ++e) {
@@ -294,28 +293,35 @@ int count_zero_diagonal(int n, int nz, const int* irn, const int* icn, const dou
       rowmax[j] = std::max(rowmax[j], std::abs(a[e]));
     }
   }
+}
+
+/// A row whose diagonal is at most kZeroDiagRel of its largest off-diagonal entry: the rows the
+/// ordering matches.
+bool zero_diagonal(double diag, double rowmax) {
+  return rowmax != 0.0 && std::abs(diag) <= kZeroDiagRel * rowmax;
+}
+
+/// Number of zero-diagonal rows; diag and rowmax are scratch.
+int count_zero_diagonal(int n, int nz, const int* irn, const int* icn, const double* a,
+                        std::vector<double>& diag, std::vector<double>& rowmax) {
+  diagonal_and_row_max(n, nz, irn, icn, a, diag, rowmax);
   int zeros = 0;
   for (int i = 0; i < n; ++i)
-    if (rowmax[i] != 0.0 && std::abs(diag[i]) <= kZeroDiagRel * rowmax[i]) ++zeros;
+    if (zero_diagonal(diag[i], rowmax[i])) ++zeros;
   return zeros;
 }
 
 /// The value-based ordering (see the file comment): zero-diagonal rows matched to a neighbour,
 /// pairs compressed, AMD on the compressed graph, pairs expanded (nonzero-diagonal row first).
 void compute_ordering(int n, int nz, const int* irn, const int* icn, const double* a, int* perm) {
-  std::vector<double> diag(n, 0.0), rowmax(n, 0.0);
+  std::vector<double> diag, rowmax;
+  diagonal_and_row_max(n, nz, irn, icn, a, diag, rowmax);
   std::vector<int> deg(static_cast<std::size_t>(n) + 1, 0);
   for (int e = 0; e < nz; ++e) {
     const int i = irn[e] - 1, j = icn[e] - 1;
-    if (!valid(n, i, j)) continue;
-    if (i == j) {
-      diag[i] += a[e];
-    } else {
-      rowmax[i] = std::max(rowmax[i], std::abs(a[e]));
-      rowmax[j] = std::max(rowmax[j], std::abs(a[e]));
-      ++deg[i + 1];
-      ++deg[j + 1];
-    }
+    if (!valid(n, i, j) || i == j) continue;
+    ++deg[i + 1];
+    ++deg[j + 1];
   }
   for (int i = 0; i < n; ++i) deg[i + 1] += deg[i];
   std::vector<int> adj(static_cast<std::size_t>(deg[n]));
@@ -333,7 +339,7 @@ void compute_ordering(int n, int nz, const int* irn, const int* icn, const doubl
   }
   std::vector<int> mate(n, -1);
   for (int i = 0; i < n; ++i) {
-    if (mate[i] >= 0 || rowmax[i] == 0.0 || std::abs(diag[i]) > kZeroDiagRel * rowmax[i]) continue;
+    if (mate[i] >= 0 || !zero_diagonal(diag[i], rowmax[i])) continue;
     int best = -1;
     double best_w = 0.0;
     for (int p = deg[i]; p < deg[i + 1]; ++p)
@@ -359,7 +365,7 @@ void compute_ordering(int n, int nz, const int* irn, const int* icn, const doubl
       second.push_back(-1);
     } else {
       // The zero-diagonal row goes second: the partner's pivot gives it a nonzero diagonal.
-      const bool i_zero = std::abs(diag[i]) <= kZeroDiagRel * rowmax[i];
+      const bool i_zero = zero_diagonal(diag[i], rowmax[i]);
       first.push_back(i_zero ? mate[i] : i);
       second.push_back(i_zero ? i : mate[i]);
     }
