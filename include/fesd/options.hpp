@@ -128,15 +128,32 @@ enum class MpccMode {
 std::string_view to_string(MpccMode v);
 bool parse(std::string_view name, MpccMode& out);
 
+/// How sigma shrinks from one NLP of the homotopy to the next (nosnoc's homotopy_update_rule).
+enum class HomotopyUpdateRule {
+  Linear,       ///< sigma_{k+1} = max(sigma_N, slope sigma_k)  (default)
+  Superlinear,  ///< sigma_{k+1} = max(sigma_N, min(slope sigma_k, sigma_k^exponent))
+};
+/// Problem-file key `homotopy_update_rule`: "linear", "superlinear" (nosnoc's LINEAR, SUPERLINEAR
+/// too).
+std::string_view to_string(HomotopyUpdateRule v);
+bool parse(std::string_view name, HomotopyUpdateRule& out);
+
 /// The MPCC homotopy: a sequence of relaxed NLPs with theta_i lambda_i <= sigma (Scholtes),
-/// sigma_{k+1} = homotopy_update_slope * sigma_k, until the complementarity residual (the largest
-/// product of a complementarity pair, cross-complementarity pairs included) is <=
-/// complementarity_tol.
+/// sigma_{k+1} = homotopy_update_slope * sigma_k (homotopy_update_rule), until the complementarity
+/// residual (the largest product of a complementarity pair, cross-complementarity pairs included)
+/// is <= complementarity_tol.
 struct HomotopyOptions {
   MpccMode mpcc_mode = MpccMode::ScholtesIneq;  ///< `mpcc_mode`
   double sigma_0 = 1.0;                         ///< `sigma_0` > 0: first relaxation
   double homotopy_update_slope = 0.1;           ///< `homotopy_update_slope` in (0, 1)
-  double sigma_N = 1e-12;                       ///< `sigma_N` > 0: smallest sigma used
+  /// `homotopy_update_rule`: linear (default) or superlinear, sigma_{k+1} = max(sigma_N,
+  /// min(slope sigma_k, sigma_k^homotopy_update_exponent)): the same steps as linear while
+  /// sigma_k > slope^(1 / (exponent - 1)) (0.01 with nosnoc's 0.1 and 1.5), longer ones below.
+  HomotopyUpdateRule homotopy_update_rule = HomotopyUpdateRule::Linear;
+  /// `homotopy_update_exponent` in (1, 10]: the superlinear rule's exponent (nosnoc's default
+  /// 1.5); unused by the linear rule.
+  double homotopy_update_exponent = 1.5;
+  double sigma_N = 1e-12;             ///< `sigma_N` > 0: smallest sigma used
   double complementarity_tol = 1e-9;  ///< `complementarity_tol` > 0: stop when residual <= this
   /// `N_homotopy`: maximum number of NLPs per solve, 0..1000. 0 (default): enough for sigma to
   /// reach sigma_N, ceil(log(sigma_N / sigma_0) / log(slope)) + 1 (13 with the defaults).
@@ -265,9 +282,13 @@ std::vector<std::string> validate(const IntegratorOptions& o);
 /// Throws fesd::InvalidOption with all messages of validate() if any.
 void check(const IntegratorOptions& o);
 
-/// Number of NLPs of one homotopy: N_homotopy, or (0) enough for sigma to reach sigma_N.
+/// The sigma of the NLP after one at sigma: homotopy_update_rule with homotopy_update_slope and
+/// homotopy_update_exponent, never below sigma_N.
+double next_sigma(const HomotopyOptions& o, double sigma);
+/// Number of NLPs of one homotopy: N_homotopy, or (0) enough for sigma to reach sigma_N (linear:
+/// ceil(log(sigma_N / sigma_0) / log(slope)) + 1).
 int homotopy_length(const HomotopyOptions& o);
-/// The sigma of a homotopy's last NLP: max(sigma_N, sigma_0 slope^(homotopy_length - 1)).
+/// The sigma of a homotopy's last NLP: next_sigma() applied homotopy_length - 1 times to sigma_0.
 double final_sigma(const HomotopyOptions& o);
 /// Valid settings that cannot be expected to reach complementarity_tol, one sentence each: the
 /// homotopy's last sigma above complementarity_tol (sigma_N too large, or N_homotopy too small

@@ -380,11 +380,13 @@ void print_solver_header(const std::string& n_fe, const fesd::DiscretizationOpti
                fesd::to_string(d.step_eq));
   }
   out::print("\n");
-  out::print(
-      "  homotopy    mpcc_mode = {}, sigma_0 = {:g}, slope = {:g}, sigma_N = {:g}, "
-      "complementarity_tol = {:g}, N_homotopy = {}\n",
-      fesd::to_string(h.mpcc_mode), h.sigma_0, h.homotopy_update_slope, h.sigma_N,
-      h.complementarity_tol, h.max_homotopy_steps);
+  out::print("  homotopy    mpcc_mode = {}, sigma_0 = {:g}, slope = {:g}, ",
+             fesd::to_string(h.mpcc_mode), h.sigma_0, h.homotopy_update_slope);
+  if (h.homotopy_update_rule != fesd::HomotopyUpdateRule::Linear)
+    out::print("{} (exponent {:g}), ", fesd::to_string(h.homotopy_update_rule),
+               h.homotopy_update_exponent);
+  out::print("sigma_N = {:g}, complementarity_tol = {:g}, N_homotopy = {}\n", h.sigma_N,
+             h.complementarity_tol, h.max_homotopy_steps);
   out::print("  ipopt       tol = {:g}, acceptable_tol = {:g}, max_iter = {}, print_level = {}",
              nlp.tol, nlp.acceptable_tol, nlp.max_iter, nlp.print_level);
   for (const auto& [key, value] : nlp.extra) out::print(", {} = {}", key, value);

@@ -351,6 +351,13 @@ std::vector<Option> build() {
   o.push_back(scalar<&T::homotopy, &H::homotopy_update_slope>(
       kHom, "homotopy_update_slope", kBoth, "sigma_{k+1} = slope * sigma_k",
       "homotopy_update_slope", Range{.min = 0, .max = 1, .min_open = true, .max_open = true}));
+  o.push_back(scalar<&T::homotopy, &H::homotopy_update_rule>(
+      kHom, "homotopy_update_rule", kBoth,
+      "linear: slope * sigma_k; superlinear: min(slope * sigma_k, sigma_k^exponent)",
+      "homotopy_update_rule"));
+  o.push_back(scalar<&T::homotopy, &H::homotopy_update_exponent>(
+      kHom, "homotopy_update_exponent", kBoth, "exponent of the superlinear rule",
+      "homotopy_update_exponent", Range{.min = 1, .max = 10, .min_open = true}));
   with(scalar<&T::homotopy, &H::sigma_N>(kHom, "sigma_N", kBoth, "smallest sigma", "sigma_N",
                                          kPositive),
        [](Option& x) { x.rule = sigma_N_at_most_sigma_0; });

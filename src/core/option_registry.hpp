@@ -121,6 +121,8 @@ template <>
 std::span<const std::string_view> enum_names<KktSolver>();
 template <>
 std::span<const std::string_view> enum_names<StepSolver>();
+template <>
+std::span<const std::string_view> enum_names<HomotopyUpdateRule>();
 
 /// Every option, table by table.
 std::span<const Option> all();

@@ -32,6 +32,7 @@ constexpr std::array<std::string_view, 3> kOcpInitialization{"constant", "simula
 constexpr std::array<std::string_view, 4> kKktSolver{"auto", "sparse_ldl", "dense", "mumps"};
 constexpr std::array<std::string_view, 2> kStepSolver{"homotopy", "active_set"};
 constexpr std::array<std::string_view, 2> kDcsMode{"stewart", "step"};
+constexpr std::array<std::string_view, 2> kHomotopyUpdateRule{"linear", "superlinear"};
 
 template <class E, std::size_t K>
 std::string_view name_of(const std::array<std::string_view, K>& names, E v) {
@@ -97,6 +98,10 @@ template <>
 std::span<const std::string_view> enum_names<DcsMode>() {
   return kDcsMode;
 }
+template <>
+std::span<const std::string_view> enum_names<HomotopyUpdateRule>() {
+  return kHomotopyUpdateRule;
+}
 }  // namespace registry
 
 std::string_view to_string(DcsMode v) {
@@ -161,6 +166,18 @@ std::string_view to_string(OcpInitialization v) {
 bool parse(std::string_view name, OcpInitialization& out) {
   return parse_from(kOcpInitialization, name, out);
 }
+std::string_view to_string(HomotopyUpdateRule v) {
+  return name_of(kHomotopyUpdateRule, v);
+}
+bool parse(std::string_view name, HomotopyUpdateRule& out) {
+  // nosnoc's spellings (HomotopyUpdateRule.LINEAR, .SUPERLINEAR) too.
+  for (std::size_t i = 0; i < kHomotopyUpdateRule.size(); ++i)
+    if (kHomotopyUpdateRule[i] == name || upper(kHomotopyUpdateRule[i]) == name) {
+      out = static_cast<HomotopyUpdateRule>(i);
+      return true;
+    }
+  return false;
+}
 std::string_view to_string(KktSolver v) {
   return name_of(kKktSolver, v);
 }
@@ -182,17 +199,30 @@ std::vector<std::string> validate(const HomotopyOptions& o) {
   return registry::check(registry::Table::Homotopy, registry::target_of(o));
 }
 
+double next_sigma(const HomotopyOptions& o, double sigma) {
+  double next = o.homotopy_update_slope * sigma;
+  if (o.homotopy_update_rule == HomotopyUpdateRule::Superlinear)
+    next = std::min(next, std::pow(sigma, o.homotopy_update_exponent));
+  return std::max(next, o.sigma_N);
+}
+
 int homotopy_length(const HomotopyOptions& o) {
   if (o.max_homotopy_steps > 0) return o.max_homotopy_steps;
-  return 1 + static_cast<int>(std::ceil(
-                 std::log(o.sigma_N / o.sigma_0) / std::log(o.homotopy_update_slope) - 1e-9));
+  if (o.homotopy_update_rule == HomotopyUpdateRule::Linear)
+    return 1 + static_cast<int>(std::ceil(
+                   std::log(o.sigma_N / o.sigma_0) / std::log(o.homotopy_update_slope) - 1e-9));
+  // Superlinear: the NLPs until sigma reaches sigma_N, as the homotopy takes them (at most as
+  // many as the linear rule's; 1000 is N_homotopy's own upper bound).
+  int n = 1;
+  for (double sigma = o.sigma_0; sigma > o.sigma_N * (1 + 1e-9) && n < 1000; ++n)
+    sigma = next_sigma(o, sigma);
+  return n;
 }
 
 double final_sigma(const HomotopyOptions& o) {
-  // As the homotopy computes it: sigma_{k+1} = max(slope sigma_k, sigma_N).
+  // As the homotopy computes it.
   double sigma = o.sigma_0;
-  for (int k = 1; k < homotopy_length(o); ++k)
-    sigma = std::max(o.homotopy_update_slope * sigma, o.sigma_N);
+  for (int k = 1; k < homotopy_length(o); ++k) sigma = next_sigma(o, sigma);
   return sigma;
 }
 

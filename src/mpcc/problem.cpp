@@ -217,7 +217,7 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
       }
     }
     // After a smaller step that converged, the step to the target; after that, the schedule's.
-    if (sigma <= target) target = std::max(o.homotopy_update_slope * sigma, o.sigma_N);
+    if (sigma <= target) target = next_sigma(o, sigma);
     sigma = target;
   }
   next_row_ = static_cast<int>(res.rows.size());

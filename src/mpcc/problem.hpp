@@ -121,7 +121,7 @@ class Problem {
 
   // ---- solving ----
 
-  /// The homotopy from the guess: sigma_0, then sigma_{k+1} = homotopy_update_slope * sigma_k
+  /// The homotopy from the guess: sigma_0, then sigma_{k+1} = next_sigma(sigma_k) (update rule)
   /// down to sigma_N, each NLP warm-started from the last, until an NLP converges with a
   /// complementarity residual <= complementarity_tol (Success), or sigma reaches sigma_N / the
   /// step limit is hit. NLPs far from the end (sigma > 10 complementarity_tol) are solved to

@@ -131,6 +131,43 @@ TEST(OptionRegistry, NamedRules) {
                                       "simulation.N_sim = 0: must be >= 1"}));
 }
 
+// The homotopy's sigma schedule (HomotopyOptions::homotopy_update_rule): linear by default;
+// nosnoc's superlinear rule max(sigma_N, min(slope sigma, sigma^exponent)) from sigma_0 = 1 to
+// sigma_N = 1e-6 with slope 0.1 and exponent 1.5: 1, 0.1, 0.01, 1e-3, 10^-4.5, 1e-6.
+TEST(OptionRegistry, HomotopyUpdateRules) {
+  fesd::HomotopyOptions h;
+  h.sigma_0 = 1.0;
+  h.sigma_N = 1e-6;
+  EXPECT_EQ(fesd::homotopy_length(h), 7);
+  EXPECT_DOUBLE_EQ(fesd::next_sigma(h, 1e-3), 1e-4);
+  EXPECT_DOUBLE_EQ(fesd::next_sigma(h, 1e-6), 1e-6);
+  h.homotopy_update_rule = fesd::HomotopyUpdateRule::Superlinear;
+  const std::vector<double> expected = {1.0, 0.1, 0.01, 1e-3, std::pow(10.0, -4.5), 1e-6};
+  double sigma = h.sigma_0;
+  for (std::size_t k = 1; k < expected.size(); ++k) {
+    sigma = fesd::next_sigma(h, sigma);
+    EXPECT_NEAR(sigma, expected[k], 1e-14 * expected[k]) << k;
+  }
+  EXPECT_EQ(fesd::homotopy_length(h), 6);
+  EXPECT_NEAR(fesd::final_sigma(h), 1e-6, 1e-20);
+  EXPECT_DOUBLE_EQ(fesd::next_sigma(h, 10.0), 1.0);  // above 1 the slope is the smaller step
+  h.homotopy_update_exponent = 2.0;                  // sigma^2 < 0.1 sigma below 0.1
+  EXPECT_DOUBLE_EQ(fesd::next_sigma(h, 0.01), 1e-4);
+  EXPECT_TRUE(fesd::validate(h).empty());
+  h.homotopy_update_exponent = 1.0;
+  EXPECT_FALSE(fesd::validate(h).empty());
+  h.homotopy_update_exponent = 11.0;
+  EXPECT_FALSE(fesd::validate(h).empty());
+  fesd::HomotopyUpdateRule rule{};
+  for (const char* name : {"linear", "LINEAR"}) {
+    ASSERT_TRUE(fesd::parse(name, rule)) << name;
+    EXPECT_EQ(rule, fesd::HomotopyUpdateRule::Linear);
+  }
+  ASSERT_TRUE(fesd::parse("SUPERLINEAR", rule));
+  EXPECT_EQ(fesd::to_string(rule), "superlinear");
+  EXPECT_FALSE(fesd::parse("quadratic", rule));
+}
+
 TEST(OptionRegistry, EnumNamesComeFromTheEnumsOwnTable) {
   for (const Option& o : registry::all()) {
     if (o.kind != Kind::Enum) continue;

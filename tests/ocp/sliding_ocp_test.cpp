@@ -72,6 +72,30 @@ TEST(SlidingModeOcp, NosnocExampleReachesNosnocPyObjective) {
   EXPECT_EQ(r.switches.size(), 4u);
 }
 
+// REAL SOLVE (about 0.4 s): nosnoc's superlinear homotopy update (homotopy_update_rule =
+// superlinear, exponent 1.5) on nosnoc_py's example of (61): sigma_{k+1} = max(sigma_N,
+// min(0.1 sigma_k, sigma_k^1.5)) takes 1, 0.1, 0.01, 1e-3, 10^-4.5, 10^-6.75, 10^-10.125 (then
+// sigma_N = 1e-12 if needed): 7 NLPs instead of the linear rule's 10, and the same optimum.
+TEST(SlidingModeOcp, SuperlinearHomotopyTakesNosnocsSigmas) {
+  fesd::OcpProblem q = fesd::load_ocp_problem(std::string(FESD_SOURCE_DIR) +
+                                              "/examples/nosnoc/ocp_sliding_mode_nosnoc.toml");
+  q.options.discretization.pin_sliding_exits = false;
+  q.options.homotopy.active_set_sigma = 0;
+  fesd::apply_override(q, "homotopy_update_rule", "SUPERLINEAR");  // nosnoc's spelling
+  ASSERT_EQ(q.options.homotopy.homotopy_update_rule, fesd::HomotopyUpdateRule::Superlinear);
+  ASSERT_EQ(q.options.homotopy.sigma_N, 1e-12);
+  EXPECT_EQ(fesd::homotopy_length(q.options.homotopy), 8);
+  const fesd::OcpResult r = fesd::solve(q.ocp, q.options);
+  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+  const std::vector<double> sigma = {
+      1, 0.1, 0.01, 1e-3, std::pow(10.0, -4.5), std::pow(10.0, -6.75), std::pow(10.0, -10.125)};
+  ASSERT_EQ(r.homotopy.size(), sigma.size());
+  for (std::size_t k = 0; k < sigma.size(); ++k)
+    EXPECT_NEAR(r.homotopy[k].sigma, sigma[k], 1e-12 * sigma[k]) << "NLP " << k;
+  EXPECT_NEAR(r.objective, 5.5944610, 1e-6);  // as the linear homotopy (test above)
+  EXPECT_EQ(r.switches.size(), 4u);
+}
+
 // REAL SOLVES (about 3 s): HomotopyOptions::active_set_sigma (default 1e-4) ends the homotopy of
 // nosnoc_py's example once the active sets are the same after two NLPs at sigma <= 1e-4, with one
 // NLP whose active sets are fixed and sliding exits pinned: the cost and switch times of the full
