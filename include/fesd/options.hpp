@@ -199,6 +199,11 @@ struct HomotopyOptions {
   /// `s_elastic_0` >= 0, <= s_elastic_max (optimal control, elastic modes): the first NLP's guess
   /// of s. nosnoc's s_elastic_0 (its default 1).
   double s_elastic_0 = 0.0;
+  /// `objective_scaling_direct` (optimal control, penalty modes ell_1_penalty, elastic_ineq,
+  /// elastic_two_sided): the NLP objective J + (1/sigma) P (true, default) or sigma J + P (false,
+  /// nosnoc's inverse scaling), P the penalty (sum of products or the elastic s). Same minimizers;
+  /// the homotopy rows' objective is the NLP's, so sigma J + P with false.
+  bool objective_scaling_direct = true;
 };
 
 /// The linear solver behind IPOPT's KKT systems (docs/kkt-solver.md).

@@ -385,8 +385,15 @@ void print_solver_header(const std::string& n_fe, const fesd::DiscretizationOpti
   if (h.homotopy_update_rule != fesd::HomotopyUpdateRule::Linear)
     out::print("{} (exponent {:g}), ", fesd::to_string(h.homotopy_update_rule),
                h.homotopy_update_exponent);
-  out::print("sigma_N = {:g}, complementarity_tol = {:g}, N_homotopy = {}\n", h.sigma_N,
+  out::print("sigma_N = {:g}, complementarity_tol = {:g}, N_homotopy = {}", h.sigma_N,
              h.complementarity_tol, h.max_homotopy_steps);
+  const bool elastic =
+      h.mpcc_mode == fesd::MpccMode::ElasticIneq || h.mpcc_mode == fesd::MpccMode::ElasticTwoSided;
+  if (elastic)
+    out::print(", s_elastic_max = {:g}, s_elastic_0 = {:g}", h.s_elastic_max, h.s_elastic_0);
+  if (!h.objective_scaling_direct && (elastic || h.mpcc_mode == fesd::MpccMode::L1Penalty))
+    out::print(", objective_scaling_direct = false (sigma J + P)");
+  out::print("\n");
   out::print("  ipopt       tol = {:g}, acceptable_tol = {:g}, max_iter = {}, print_level = {}",
              nlp.tol, nlp.acceptable_tol, nlp.max_iter, nlp.print_level);
   for (const auto& [key, value] : nlp.extra) out::print(", {} = {}", key, value);

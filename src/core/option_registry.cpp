@@ -387,6 +387,10 @@ std::vector<Option> build() {
            "first guess of the elastic variable s (elastic_ineq, elastic_two_sided)", "s_elastic_0",
            Range{.min = 0}),
        [](Option& x) { x.rule = s_elastic_0_at_most_max; });
+  o.push_back(scalar<&T::homotopy, &H::objective_scaling_direct>(
+      kHom, "objective_scaling_direct", Use::Ocp,
+      "penalty modes: objective J + (1/sigma) P (true) or sigma J + P (false)",
+      "objective_scaling_direct"));
   o.push_back(scalar<&T::homotopy, &H::fix_active_set>(
       kHom, "fix_active_set", Use::Simulation,
       "solve each step's last NLP once more with its active set fixed (exact complementarity)",

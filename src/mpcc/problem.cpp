@@ -101,9 +101,9 @@ void Problem::add_complementarity(const std::vector<CompGroup>& groups,
   residual_pairs_.insert(residual_pairs_.end(), residual_pairs.begin(), residual_pairs.end());
 }
 
-void Problem::relax(MpccMode mode, double s_elastic_max, double s_elastic_0) {
+void Problem::relax(MpccMode mode, double s_elastic_max, double s_elastic_0, bool scaling_direct) {
   if (relaxation_) throw InternalError("mpcc::Problem::relax(): called twice");
-  relaxation_.emplace(nlp_, groups_, mode, s_elastic_max, s_elastic_0);
+  relaxation_.emplace(nlp_, groups_, mode, s_elastic_max, s_elastic_0, scaling_direct);
 }
 
 void Problem::finalize() {

@@ -87,12 +87,14 @@ class Problem {
   /// fesd::InvalidOption when the mode cannot express a group). After the last
   /// add_complementarity(); the variables are then complete (copy_inputs_from() works).
   /// `s_elastic_max`, `s_elastic_0`: bounds [0, s_elastic_max] and guess of the elastic variable
-  /// (elastic modes; HomotopyOptions).
-  void relax(MpccMode mode, double s_elastic_max = nlp::kInf, double s_elastic_0 = 0.0);
-  /// relax() in the options' mpcc_mode with their elastic variable (s_elastic_max, s_elastic_0):
-  /// the optimal-control solvers.
+  /// (elastic modes; HomotopyOptions); `scaling_direct`: HomotopyOptions::objective_scaling_direct.
+  void relax(MpccMode mode, double s_elastic_max = nlp::kInf, double s_elastic_0 = 0.0,
+             bool scaling_direct = true);
+  /// relax() in the options' mpcc_mode with their elastic variable (s_elastic_max, s_elastic_0)
+  /// and objective scaling: the optimal-control solvers.
   void relax(const HomotopyOptions& options) {
-    relax(options.mpcc_mode, options.s_elastic_max, options.s_elastic_0);
+    relax(options.mpcc_mode, options.s_elastic_max, options.s_elastic_0,
+          options.objective_scaling_direct);
   }
   /// Builds the sparsity of the NLP, probed at the current guess. After relax().
   void finalize();

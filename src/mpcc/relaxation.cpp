@@ -113,7 +113,7 @@ void set_sigma(nlp::BlockNlp& nlp, const std::vector<int>& rows, double sigma) {
 }
 
 Relaxation::Relaxation(nlp::BlockNlp& nlp, const std::vector<CompGroup>& groups, MpccMode mode,
-                       double s_max, double s_0)
+                       double s_max, double s_0, bool scaling_direct)
     : mode_(mode), group_rows_(groups.size(), -1) {
   if (mode == MpccMode::ScholtesIneq) {
     // Exactly the rows of add_scholtes_rows (results stay bit-identical to it), empty groups
@@ -178,8 +178,12 @@ Relaxation::Relaxation(nlp::BlockNlp& nlp, const std::vector<CompGroup>& groups,
         break;  // handled above
     }
   }
+  const int n_cost = nlp.num_objectives() - static_cast<int>(objectives_.size());
   if (elastic)
     objectives_.push_back(nlp.add_objective(nlp::make_block(Identity{}), {elastic_var_}, 1.0));
+  inverse_ = !scaling_direct && !objectives_.empty();
+  if (inverse_)
+    for (int o = 0; o < n_cost; ++o) cost_terms_.emplace_back(o, nlp.objective_weight(o));
 }
 
 void Relaxation::set_sigma(nlp::BlockNlp& nlp, double sigma) const {
@@ -189,7 +193,8 @@ void Relaxation::set_sigma(nlp::BlockNlp& nlp, double sigma) const {
     nlp.g_ub[r] = sigma;
   }
   for (int r : equal_rows_) nlp.g_lb[r] = nlp.g_ub[r] = sigma;
-  for (int o : objectives_) nlp.set_objective_weight(o, 1.0 / sigma);
+  for (int o : objectives_) nlp.set_objective_weight(o, inverse_ ? 1.0 : 1.0 / sigma);
+  for (const auto& [o, w] : cost_terms_) nlp.set_objective_weight(o, sigma * w);
   if (sigma_var_ >= 0) nlp.x_lb[sigma_var_] = nlp.x_ub[sigma_var_] = nlp.x_init[sigma_var_] = sigma;
 }
 

@@ -23,6 +23,13 @@
 //                       ELASTIC_TWO_SIDED). For groups with G >= 0 the lower row is inactive and
 //                       the mode equals elastic_ineq.
 //
+// The penalty modes (ell_1_penalty, elastic_ineq, elastic_two_sided) weigh their term 1 / sigma
+// against the cost J (every objective term added before the relaxation, OCP cost and step
+// equilibration alike): J + (1/sigma) P. With objective_scaling_direct = false (nosnoc's inverse
+// scaling) the NLP's objective is sigma J + P instead: the same minimizers, an objective that
+// stays O(1) as sigma -> 0 rather than growing as 1/sigma, so that IPOPT's scaled tolerances see
+// another problem. The other modes have no penalty term and ignore the setting.
+//
 // The elastic variable s is nosnoc's s_elastic, in [s_elastic_min, s_elastic_max] with the guess
 // s_elastic_0. fesd's defaults (HomotopyOptions::s_elastic_max = 1e20, i.e. unbounded, and
 // s_elastic_0 = 0) are not nosnoc's (10 and 1, in MATLAB nosnoc and nosnoc_py alike): the
@@ -42,6 +49,7 @@
 // free sign can neither be penalized (it would be driven to -inf), nor smoothed by a C-function
 // (which needs b >= 0), nor be set = sigma (its sign is not known in advance).
 #pragma once
+#include <utility>
 #include <vector>
 
 #include "discretization/fesd_interval.hpp"
@@ -60,11 +68,12 @@ class Relaxation {
   /// Throws fesd::InvalidOption naming the problem when the mode cannot express a group
   /// (fischer_burmeister on a group without a common factor).
   /// `s_max`, `s_0`: bounds [0, s_max] and guess of the elastic variable (elastic modes only).
+  /// `scaling_direct`: the penalty modes' objective J + (1/sigma) P (true) or sigma J + P.
   Relaxation(nlp::BlockNlp& nlp, const std::vector<CompGroup>& groups, MpccMode mode,
-             double s_max = nlp::kInf, double s_0 = 0.0);
+             double s_max = nlp::kInf, double s_0 = 0.0, bool scaling_direct = true);
 
   /// Sets sigma: row bounds, the fixed sigma variable (fischer_burmeister), objective weights
-  /// 1 / sigma (ell_1_penalty, elastic_ineq).
+  /// (penalty modes: 1 / sigma on the penalty, or sigma on the cost terms).
   void set_sigma(nlp::BlockNlp& nlp, double sigma) const;
 
   MpccMode mode() const { return mode_; }
@@ -82,7 +91,11 @@ class Relaxation {
   std::vector<int> upper_rows_;      // -inf <= G <= sigma
   std::vector<int> two_sided_rows_;  // -sigma <= G <= sigma
   std::vector<int> equal_rows_;      // G = sigma
-  std::vector<int> objectives_;      // objective terms with weight 1 / sigma
+  std::vector<int> objectives_;      // penalty terms: weight 1 / sigma (or 1, inverse scaling)
+  // Inverse scaling: the cost terms (objectives before the relaxation's) and their own weights,
+  // which set_sigma multiplies by sigma.
+  std::vector<std::pair<int, double>> cost_terms_;
+  bool inverse_ = false;  // a penalty mode with objective_scaling_direct = false
   int sigma_var_ = -1, elastic_var_ = -1;
 };
 

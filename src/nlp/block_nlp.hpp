@@ -54,6 +54,8 @@ class BlockNlp {
   /// Hessian as computed before the planned passes. Call after finalize().
   void use_column_hessian_passes();
   void set_objective_weight(int objective, double w) { objectives_[objective].weight = w; }
+  double objective_weight(int objective) const { return objectives_[objective].weight; }
+  int num_objectives() const { return static_cast<int>(objectives_.size()); }
 
   // Evaluations; each returns false if a block produced a non-finite value.
   bool eval_f(const double* x, double& f) const;

@@ -83,6 +83,70 @@ TEST_P(TinyMpcc, ReachesTheLocalMinimizerOfTheStart) {
 }
 INSTANTIATE_TEST_SUITE_P(Modes, TinyMpcc, ::testing::ValuesIn(kAllModes), mode_name);
 
+// ---- objective_scaling_direct ------------------------------------------------------------
+
+// nosnoc's inverse scaling (objective_scaling_direct = false): a penalty mode's NLP objective is
+// sigma J + P instead of J + (1/sigma) P, i.e. exactly sigma times it, at every point and sigma,
+// with the gradient scaled alike; modes without a penalty term ignore the setting. On the
+// two-variable MPCC both scalings reach the start's minimizer (1, 0).
+TEST(ObjectiveScaling, InverseIsSigmaTimesDirect) {
+  const std::vector<double> point{0.7, 0.3, 0.25};  // x, y, and s where a mode has it
+  for (MpccMode mode : kAllModes) {
+    const bool penalty = mode == MpccMode::L1Penalty || mode == MpccMode::ElasticIneq ||
+                         mode == MpccMode::ElasticTwoSided;
+    fesd::nlp::BlockNlp nlps[2];
+    std::vector<fesd::mpcc::Relaxation> relaxations;
+    for (const bool direct : {true, false}) {
+      fesd::nlp::BlockNlp& nlp = nlps[direct ? 0 : 1];
+      const int x = nlp.add_variables(1, 0.0, fesd::nlp::kInf, 0.9);
+      const int y = nlp.add_variables(1, 0.0, fesd::nlp::kInf, 0.2);
+      nlp.add_objective(fesd::nlp::make_block(DistanceTo{1.0}), {x, y}, 2.0);
+      const std::vector<fesd::mpcc::CompPair> pairs{{x, y}};
+      relaxations.emplace_back(nlp, std::vector{fesd::mpcc::CompGroup{pairs}}, mode,
+                               fesd::nlp::kInf, 0.0, direct);
+      nlp.finalize();
+    }
+    const int n = nlps[0].num_variables();
+    ASSERT_EQ(n, nlps[1].num_variables());
+    for (double sigma : {1.0, 1e-3}) {
+      double f[2];
+      std::vector<double> grad[2];
+      for (int k = 0; k < 2; ++k) {
+        relaxations[k].set_sigma(nlps[k], sigma);
+        std::vector<double> w(nlps[k].x_init);
+        for (int i = 0; i < n && i < 3; ++i)
+          if (nlps[k].x_lb[i] < nlps[k].x_ub[i]) w[i] = point[i];
+        grad[k].resize(n);
+        ASSERT_TRUE(nlps[k].eval_f(w.data(), f[k]));
+        ASSERT_TRUE(nlps[k].eval_grad_f(w.data(), grad[k].data()));
+      }
+      const double scale = penalty ? sigma : 1.0;
+      EXPECT_NEAR(f[1], scale * f[0], 1e-14 * std::abs(f[1]) + 1e-300)
+          << fesd::to_string(mode) << " sigma " << sigma;
+      for (int i = 0; i < n; ++i)
+        EXPECT_NEAR(grad[1][i], scale * grad[0][i], 1e-14 * std::abs(grad[1][i]) + 1e-300)
+            << fesd::to_string(mode) << " sigma " << sigma << " variable " << i;
+    }
+    if (!penalty) continue;
+    fesd::mpcc::Problem problem;
+    fesd::nlp::BlockNlp& nlp = problem.nlp();
+    const int x = nlp.add_variables(1, 0.0, fesd::nlp::kInf, 0.9);
+    const int y = nlp.add_variables(1, 0.0, fesd::nlp::kInf, 0.2);
+    nlp.add_objective(fesd::nlp::make_block(DistanceTo{1.0}), {x, y});
+    const std::vector<fesd::mpcc::CompPair> pairs{{x, y}};
+    problem.add_complementarity({fesd::mpcc::CompGroup{pairs}}, pairs);
+    problem.relax(mode, fesd::nlp::kInf, 0.0, /*scaling_direct=*/false);
+    problem.finalize();
+    const auto solver = fesd::nlp::make_solver(fesd::NlpOptions{});
+    fesd::HomotopyOptions options;
+    options.sigma_0 = 0.1;  // as TinyMpcc
+    const auto res = problem.solve_homotopy(*solver, options);
+    ASSERT_EQ(res.status, fesd::Status::Success) << fesd::to_string(mode);
+    EXPECT_NEAR(problem.solution()[x], 1.0, 1e-6) << fesd::to_string(mode);
+    EXPECT_NEAR(problem.solution()[y], 0.0, 1e-6) << fesd::to_string(mode);
+  }
+}
+
 // ---- intermediate_tol ---------------------------------------------------------------------
 
 /// IPOPT, recording the tolerance the homotopy asks for in each NLP (0: the configured one).

@@ -459,6 +459,20 @@ TEST(OcpElasticVariable, BoundFromTheFileReachesTheNlp) {
   const OcpResult nosnoc = solve(q.ocp, q.options);
   ASSERT_EQ(nosnoc.status, Status::Success) << nosnoc.message;
   EXPECT_NEAR(nosnoc.objective, def.objective, 1e-6);
+  // nosnoc's inverse scaling (objective_scaling_direct = false, as nosnoc_py's hysteresis
+  // examples): sigma J + s instead of J + s / sigma, the same optimum; the homotopy rows report
+  // the NLP's objective, sigma times the direct one.
+  apply_override(q, "objective_scaling_direct", "false");
+  EXPECT_FALSE(q.options.homotopy.objective_scaling_direct);
+  const OcpResult inverse = solve(q.ocp, q.options);
+  ASSERT_EQ(inverse.status, Status::Success) << inverse.message;
+  EXPECT_NEAR(inverse.objective, def.objective, 1e-6);
+  ASSERT_FALSE(inverse.homotopy.empty());
+  const HomotopyRow& last = inverse.homotopy.back();
+  // sigma (J + s / sigma): J = 5.596 (cost and step equilibration, nosnoc_py's figure), s / sigma
+  // small at the last sigma (1e-5 here).
+  EXPECT_NEAR(last.objective / last.sigma, 5.596, 0.01);
+  q.options.homotopy.objective_scaling_direct = true;
   // s_elastic_0 above s_elastic_max is refused, naming both.
   try {
     apply_override(q, "s_elastic_0", "20");
