@@ -39,20 +39,23 @@ std::string_view name_of(const std::array<std::string_view, K>& names, E v) {
   const auto i = static_cast<std::size_t>(v);
   return i < K ? names[i] : std::string_view("unknown");
 }
-template <class E, std::size_t K>
-bool parse_from(const std::array<std::string_view, K>& names, std::string_view name, E& out) {
-  for (std::size_t i = 0; i < K; ++i)
-    if (names[i] == name) {
-      out = static_cast<E>(i);
-      return true;
-    }
-  return false;
-}
-
 std::string upper(std::string_view s) {
   std::string u(s);
   for (char& ch : u) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
   return u;
+}
+
+/// The enum value named `name` in `names`; with `upper_too` also its upper-case spelling (nosnoc's
+/// enum members: RADAU_IIA, SUPERLINEAR).
+template <class E, std::size_t K>
+bool parse_from(const std::array<std::string_view, K>& names, std::string_view name, E& out,
+                bool upper_too = false) {
+  for (std::size_t i = 0; i < K; ++i)
+    if (names[i] == name || (upper_too && upper(names[i]) == name)) {
+      out = static_cast<E>(i);
+      return true;
+    }
+  return false;
 }
 
 }  // namespace
@@ -118,13 +121,7 @@ std::string_view to_string(RkScheme v) {
   return name_of(kRkScheme, v);
 }
 bool parse(std::string_view name, RkScheme& out) {
-  // nosnoc's upper-case spellings (RADAU_IIA, ...) too.
-  for (std::size_t i = 0; i < kRkScheme.size(); ++i)
-    if (kRkScheme[i] == name || upper(kRkScheme[i]) == name) {
-      out = static_cast<RkScheme>(i);
-      return true;
-    }
-  return false;
+  return parse_from(kRkScheme, name, out, /*upper_too=*/true);  // nosnoc's RADAU_IIA, ...
 }
 std::string_view to_string(CrossComp v) {
   return name_of(kCrossComp, v);
@@ -170,13 +167,7 @@ std::string_view to_string(HomotopyUpdateRule v) {
   return name_of(kHomotopyUpdateRule, v);
 }
 bool parse(std::string_view name, HomotopyUpdateRule& out) {
-  // nosnoc's spellings (HomotopyUpdateRule.LINEAR, .SUPERLINEAR) too.
-  for (std::size_t i = 0; i < kHomotopyUpdateRule.size(); ++i)
-    if (kHomotopyUpdateRule[i] == name || upper(kHomotopyUpdateRule[i]) == name) {
-      out = static_cast<HomotopyUpdateRule>(i);
-      return true;
-    }
-  return false;
+  return parse_from(kHomotopyUpdateRule, name, out, /*upper_too=*/true);  // nosnoc's LINEAR, ...
 }
 std::string_view to_string(KktSolver v) {
   return name_of(kKktSolver, v);

@@ -45,15 +45,21 @@ struct DistanceTo {
   }
 };
 
+/// Adds x, y >= 0 from (0.9, 0.2) and weight * ((x - 1)^2 + (y - a)^2) to `nlp`; returns the pair
+/// 0 <= x _|_ y >= 0 (not yet added to any problem).
+fesd::mpcc::CompPair add_tiny_mpcc(fesd::nlp::BlockNlp& nlp, double a = 1.0, double weight = 1.0) {
+  const int x = nlp.add_variables(1, 0.0, fesd::nlp::kInf, 0.9);
+  const int y = nlp.add_variables(1, 0.0, fesd::nlp::kInf, 0.2);
+  nlp.add_objective(fesd::nlp::make_block(DistanceTo{a}), {x, y}, weight);
+  return {x, y};
+}
+
 // min (x - 1)^2 + (y - 1)^2  s.t.  0 <= x _|_ y >= 0, from (0.9, 0.2). The MPCC has two
 // minimizers, (1, 0) and (0, 1), both with objective 1; the start lies on the side of (1, 0).
 class TinyMpcc : public ::testing::TestWithParam<MpccMode> {};
 TEST_P(TinyMpcc, ReachesTheLocalMinimizerOfTheStart) {
   fesd::mpcc::Problem problem;
-  fesd::nlp::BlockNlp& nlp = problem.nlp();
-  const int x = nlp.add_variables(1, 0.0, fesd::nlp::kInf, 0.9);
-  const int y = nlp.add_variables(1, 0.0, fesd::nlp::kInf, 0.2);
-  nlp.add_objective(fesd::nlp::make_block(DistanceTo{1.0}), {x, y});
+  const auto [x, y] = add_tiny_mpcc(problem.nlp());
   const std::vector<fesd::mpcc::CompPair> pairs{{x, y}};
   problem.add_complementarity({fesd::mpcc::CompGroup{pairs}}, pairs);
   problem.relax(GetParam());
@@ -98,10 +104,7 @@ TEST(ObjectiveScaling, InverseIsSigmaTimesDirect) {
     std::vector<fesd::mpcc::Relaxation> relaxations;
     for (const bool direct : {true, false}) {
       fesd::nlp::BlockNlp& nlp = nlps[direct ? 0 : 1];
-      const int x = nlp.add_variables(1, 0.0, fesd::nlp::kInf, 0.9);
-      const int y = nlp.add_variables(1, 0.0, fesd::nlp::kInf, 0.2);
-      nlp.add_objective(fesd::nlp::make_block(DistanceTo{1.0}), {x, y}, 2.0);
-      const std::vector<fesd::mpcc::CompPair> pairs{{x, y}};
+      const std::vector<fesd::mpcc::CompPair> pairs{add_tiny_mpcc(nlp, 1.0, 2.0)};
       relaxations.emplace_back(nlp, std::vector{fesd::mpcc::CompGroup{pairs}}, mode,
                                fesd::nlp::kInf, 0.0, direct);
       nlp.finalize();
@@ -129,10 +132,7 @@ TEST(ObjectiveScaling, InverseIsSigmaTimesDirect) {
     }
     if (!penalty) continue;
     fesd::mpcc::Problem problem;
-    fesd::nlp::BlockNlp& nlp = problem.nlp();
-    const int x = nlp.add_variables(1, 0.0, fesd::nlp::kInf, 0.9);
-    const int y = nlp.add_variables(1, 0.0, fesd::nlp::kInf, 0.2);
-    nlp.add_objective(fesd::nlp::make_block(DistanceTo{1.0}), {x, y});
+    const auto [x, y] = add_tiny_mpcc(problem.nlp());
     const std::vector<fesd::mpcc::CompPair> pairs{{x, y}};
     problem.add_complementarity({fesd::mpcc::CompGroup{pairs}}, pairs);
     problem.relax(mode, fesd::nlp::kInf, 0.0, /*scaling_direct=*/false);
@@ -169,10 +169,9 @@ struct TinyProblem {
   fesd::mpcc::Problem problem;
   int x = 0, y = 0;
   explicit TinyProblem(double a) {
-    fesd::nlp::BlockNlp& nlp = problem.nlp();
-    x = nlp.add_variables(1, 0.0, fesd::nlp::kInf, 0.9);
-    y = nlp.add_variables(1, 0.0, fesd::nlp::kInf, 0.2);
-    nlp.add_objective(fesd::nlp::make_block(DistanceTo{a}), {x, y});
+    const fesd::mpcc::CompPair xy = add_tiny_mpcc(problem.nlp(), a);
+    x = xy.a;
+    y = xy.b;
     const std::vector<fesd::mpcc::CompPair> pairs{{x, y}};
     problem.add_complementarity({fesd::mpcc::CompGroup{pairs}}, pairs);
     problem.relax(MpccMode::ScholtesIneq);
