@@ -11,8 +11,8 @@ theta and lambda, phase planes, the hysteresis plane, ...).
     scripts/nosnoc_figures.py relay two_gene   # only these
     scripts/nosnoc_figures.py --reuse          # redraw from the JSON of an earlier run
 
-The JSON and fesd's raw plots go to build/nosnoc_figures/. The long rows (8, 10, 11, 24, 30) are
-not run here (docs/nosnoc-figures.md says why). Needs python3-matplotlib and Pillow
+The JSON and fesd's raw plots go to build/nosnoc_figures/. The long rows (8, 10, 11, 24) are
+not run here; rows 10, 30 and 31 only with --long (docs/nosnoc-figures.md says why). Needs python3-matplotlib and Pillow
 (hence /usr/bin/python3).
 """
 import argparse
@@ -406,6 +406,85 @@ def fig_hysteresis_car():
          f"t(T) = {x[-1, 4]:.3f}")
 
 
+# ---- rows 30, 31 (opt-in, --long: 165 s and 440 s): the gearboxes with 3 and 4 gears ----------
+def voronoi_plane(ax, fig, points, psi, w, t):
+    """The script's (psi, w) plane: the Voronoi generators (x) and the trajectory by time."""
+    ax.scatter(points[:, 0], points[:, 1], marker="x", color="k", s=30, label="generators")
+    im = ax.scatter(psi, w, c=t, cmap="hot", s=12, edgecolors="0.5", linewidths=0.3)
+    fig.colorbar(im, ax=ax, label="simulation time")
+    ax.set_xlabel("psi")
+    ax.legend(fontsize=7)
+
+
+def gearbox_figure(stem, names, psi, w_plane, w_label, points, extra_axis=None):
+    d = run("solve", stem, limit=1800)
+    t, x = boundaries(d), arr(d, "x")
+    # Without extra_axis 2 x 2 panels; with it the top row holds the three time panels and the
+    # bottom row the plane and the extra (3-D) axis.
+    fig = plt.figure(figsize=(10, 7) if extra_axis else FIGSIZE)
+    if extra_axis:
+        gs = fig.add_gridspec(2, 6)
+        cells = [gs[0, 0:2], gs[0, 2:4], gs[0, 4:6], gs[1, 0:3], gs[1, 3:6]]
+    else:
+        gs = fig.add_gridspec(2, 2)
+        cells = [gs[0, 0], gs[0, 1], gs[1, 0], gs[1, 1]]
+    ax = fig.add_subplot(cells[0])
+    for i, n in enumerate(names):
+        ax.plot(t, x[:, i], label=n)
+    ax.set_xlabel("simulation time")
+    ax.legend(fontsize=7)
+    ax = fig.add_subplot(cells[1])
+    control_steps(ax, d, 0, "u")
+    ax.set_xlabel("simulation time")
+    ax.legend(fontsize=8)
+    ax = fig.add_subplot(cells[2])
+    ax.plot(x[:, -1], x[:, 0])
+    ax.set_xlabel("physical time t")
+    ax.set_ylabel("q")
+    ax = fig.add_subplot(cells[3])
+    voronoi_plane(ax, fig, points, psi(x), w_plane(x), t)
+    ax.set_ylabel(w_label)
+    if extra_axis:
+        extra_axis(fig.add_subplot(cells[4], projection="3d"), x, t)
+    for a in fig.axes:
+        if a.name != "3d":
+            a.grid(True)
+    s = d.get("v_global", {})
+    s = s.get("s", s) if isinstance(s, dict) else s
+    save(fig, stem, f"{stem}.toml: {d['status']}, objective {d['objective']:.4f}, "
+         f"t(T) = {x[-1, -1]:.3f}, s = {float(np.ravel(s)[0]):.4f}")
+
+
+def fig_gearbox_2d():
+    shift = 0.6  # psi_shift_2 of the script
+    base = [(0.25, -0.25), (0.25, 0.25), (0.75, 0.75), (0.75, 1.25)]
+    points = np.array(base + [(a + shift, b + 1) for a, b in base])
+    gearbox_figure("hysteresis_car_control_time_optimal_2d",
+                   ["q (position)", "v (speed)", "L (fuel)", "w (auxiliary)", "t (time)"],
+                   lambda x: (x[:, 1] - 5.0) / 5.0, lambda x: x[:, 3], "w", points)
+
+
+def fig_gearbox_3d():
+    shift, a = 1.5, 0.25  # the script's control() defaults, mode TYPE_PAPER
+    z = [(a, -a, 0), (a, a, 0), (1 - a, 1 - a, 0), (1 - a, 1 + a, 0),
+         (a + shift, 1, -a), (a + shift, 1, a), (1 - a + shift, 1, 1 - a), (1 - a + shift, 1, 1 + a),
+         (a + 2 * shift, 1 - a, 1), (a + 2 * shift, 1 + a, 1), (1 - a + 2 * shift, 2 - a, 1),
+         (1 - a + 2 * shift, 2 + a, 1)]
+    points = np.array([(p, w1 + w2) for p, w1, w2 in z])  # the script's 2-D view: w1 + w2
+
+    def line_3d(ax, x, t):
+        psi = (x[:, 1] - 5.0) / 5.0
+        ax.scatter(psi, x[:, 3], x[:, 4], c=t, cmap="hot", s=8)
+        ax.set_xlabel("psi")
+        ax.set_ylabel("w1")
+        ax.set_zlabel("w2")
+
+    gearbox_figure("hysteresis_car_control_time_optimal_3d",
+                   ["q (position)", "v (speed)", "L (fuel)", "w1", "w2", "t (time)"],
+                   lambda x: (x[:, 1] - 5.0) / 5.0, lambda x: x[:, 3] + x[:, 4], "w1 + w2",
+                   points, extra_axis=line_3d)
+
+
 FIGURES = {
     "simplest": fig_simplest,
     "parametric": fig_parametric,
@@ -424,7 +503,7 @@ FIGURES = {
     "car_control": fig_car_control,
     "hysteresis_car": fig_hysteresis_car,
 }
-LONG = {"irma": fig_irma}
+LONG = {"irma": fig_irma, "gearbox_2d": fig_gearbox_2d, "gearbox_3d": fig_gearbox_3d}
 
 
 def main():
