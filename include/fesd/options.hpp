@@ -110,7 +110,8 @@ struct DiscretizationOptions {
 
 /// How the complementarity constraints of the MPCC are relaxed, smoothed or penalized in the
 /// homotopy (Sect. 5.2). sigma is the homotopy parameter of every method: sigma_0, then
-/// sigma_{k+1} = homotopy_update_slope * sigma_k down to sigma_N.
+/// sigma_{k+1} = homotopy_update_slope * sigma_k (HomotopyOptions::homotopy_update_rule) down to
+/// sigma_N.
 enum class MpccMode {
   ScholtesIneq,  ///< every complementarity constraint  w1' w2 <= sigma  (default)
   ScholtesEq,    ///< w1' w2 = sigma
@@ -156,7 +157,8 @@ struct HomotopyOptions {
   double sigma_N = 1e-12;             ///< `sigma_N` > 0: smallest sigma used
   double complementarity_tol = 1e-9;  ///< `complementarity_tol` > 0: stop when residual <= this
   /// `N_homotopy`: maximum number of NLPs per solve, 0..1000. 0 (default): enough for sigma to
-  /// reach sigma_N, ceil(log(sigma_N / sigma_0) / log(slope)) + 1 (13 with the defaults).
+  /// reach sigma_N: ceil(log(sigma_N / sigma_0) / log(slope)) + 1 with the linear rule (13 with
+  /// the defaults), as many as the superlinear rule takes with it (homotopy_length()).
   int max_homotopy_steps = 0;
   /// `homotopy_retries` 0..100 (optimal control; an integration step has its own retry policy and
   /// ignores it): an NLP that fails after a converged one at a point that violates the

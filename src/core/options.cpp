@@ -199,13 +199,15 @@ double next_sigma(const HomotopyOptions& o, double sigma) {
 
 int homotopy_length(const HomotopyOptions& o) {
   if (o.max_homotopy_steps > 0) return o.max_homotopy_steps;
-  if (o.homotopy_update_rule == HomotopyUpdateRule::Linear)
-    return 1 + static_cast<int>(std::ceil(
-                   std::log(o.sigma_N / o.sigma_0) / std::log(o.homotopy_update_slope) - 1e-9));
-  // Superlinear: the NLPs until sigma reaches sigma_N, as the homotopy takes them (at most as
-  // many as the linear rule's; 1000 is N_homotopy's own upper bound).
+  // The linear rule's count, kept finite for a slope next to 1 (1e9 NLPs: beyond any run).
+  const double linear =
+      1 + std::ceil(std::log(o.sigma_N / o.sigma_0) / std::log(o.homotopy_update_slope) - 1e-9);
+  const int n_linear = static_cast<int>(std::min(linear, 1e9));
+  if (o.homotopy_update_rule == HomotopyUpdateRule::Linear) return n_linear;
+  // Superlinear: the NLPs until sigma reaches sigma_N, as the homotopy takes them; never more
+  // than the linear rule's (each step is at least as long).
   int n = 1;
-  for (double sigma = o.sigma_0; sigma > o.sigma_N * (1 + 1e-9) && n < 1000; ++n)
+  for (double sigma = o.sigma_0; sigma > o.sigma_N * (1 + 1e-9) && n < n_linear; ++n)
     sigma = next_sigma(o, sigma);
   return n;
 }

@@ -21,8 +21,9 @@ constexpr double kFeasibleFailure = 1e-6;
 
 // Adds the row of one NLP solve (k, sigma) to res and its times and iterations to the totals.
 void record(HomotopyResult& res, const nlp::NlpResult& r, int k, double sigma) {
-  // r.objective is the NLP's objective: for ell_1_penalty and elastic_ineq it includes the
-  // penalty term (1 / sigma) * (sum of groups, or s).
+  // r.objective is the NLP's objective: in the penalty modes (ell_1_penalty, elastic_*) it
+  // includes the penalty term, J + (1 / sigma) * (sum of groups, or s), or sigma J + penalty with
+  // objective_scaling_direct = false.
   HomotopyRow row;
   row.k = k;
   row.sigma = sigma;

@@ -158,6 +158,16 @@ TEST(OptionRegistry, HomotopyUpdateRules) {
   EXPECT_FALSE(fesd::validate(h).empty());
   h.homotopy_update_exponent = 11.0;
   EXPECT_FALSE(fesd::validate(h).empty());
+  // An exponent next to 1 with a slow slope: superlinear only far below sigma_N, so as many NLPs
+  // as the linear rule (2751), down to sigma_N; and no count is cut short at 1000.
+  h.sigma_N = 1e-12;
+  h.homotopy_update_slope = 0.99;
+  h.homotopy_update_exponent = 1.0001;
+  fesd::HomotopyOptions linear = h;
+  linear.homotopy_update_rule = fesd::HomotopyUpdateRule::Linear;
+  EXPECT_EQ(fesd::homotopy_length(linear), 2751);
+  EXPECT_EQ(fesd::homotopy_length(h), 2751);
+  EXPECT_NEAR(fesd::final_sigma(h), 1e-12, 1e-24);
   fesd::HomotopyUpdateRule rule{};
   for (const char* name : {"linear", "LINEAR"}) {
     ASSERT_TRUE(fesd::parse(name, rule)) << name;
