@@ -255,6 +255,11 @@ struct OcpOptions {
   HomotopyOptions homotopy;
   NlpOptions nlp;
   OcpInitialization initialization = OcpInitialization::Constant;
+  /// `initial_theta` (nosnoc's initial_theta): every Stewart weight theta of the first NLP's guess
+  /// (all intervals, elements and stage points) set to this value in [0, 1], whatever the
+  /// initialization; lambda and mu stay the LP's. -1 (default): theta from the LP (8) at the
+  /// guessed states. Stewart's form only (the step form's variables are alpha).
+  double initial_theta = -1;
   /// Evaluate path constraints and state bounds at the RK stage points too, not only at the
   /// element boundaries.
   bool constraints_at_stages = false;

@@ -130,6 +130,14 @@ std::string fesd_needs_two_elements(const T& t, double N_FE) {
          "use_fesd = false";
 }
 
+std::string initial_theta_rule(const T& t, double v) {
+  if (v == -1) return {};
+  if (!(v >= 0 && v <= 1)) return "must be in [0, 1], or -1 (theta from the LP)";
+  if (t.discretization->dcs_mode == DcsMode::Step)
+    return "needs dcs_mode = \"stewart\" (the step form's variables are alpha, not theta)";
+  return {};
+}
+
 std::string s_elastic_0_at_most_max(const T& t, double s0) {
   const double s_max = t.homotopy->s_elastic_max;
   if (!(std::isfinite(s_max) && s_max > 0) || s0 <= s_max) return {};
@@ -298,6 +306,10 @@ std::vector<Option> build() {
       "time_freezing_tolerance", at_least(0)));
   o.push_back(scalar<&T::ocp_options, &OcpOptions::initialization>(kOcp, "initialization", ocp,
                                                                    "initial guess of the NLP", ""));
+  with(scalar<&T::ocp_options, &OcpOptions::initial_theta>(
+           kOcp, "initial_theta", ocp,
+           "every theta of the first guess set to this value (-1: the LP's)", "initial_theta"),
+       [](Option& x) { x.rule = initial_theta_rule; });
   o.push_back(scalar<&T::ocp_options, &OcpOptions::constraints_at_stages>(
       kOcp, "constraints_at_stages", ocp,
       "also impose g_path, lbx, ubx at the Runge-Kutta stage points", "g_path_at_stg"));

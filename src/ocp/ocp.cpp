@@ -174,6 +174,17 @@ void guess_external(OcpNlp& b, const Ocp& ocp, const StageParameters& p) {
   for (const auto& iv : b.iv) iv->update_lifted_guess(w);
 }
 
+/// OcpOptions::initial_theta: every theta of the guess = value (Stewart's form, validated).
+void guess_theta(OcpNlp& b, double value) {
+  auto& w = b.mpcc.guess();
+  for (const auto& iv : b.iv) {
+    for (int n = 0; n < iv->N_FE(); ++n)
+      for (int m = 0; m < iv->n_s(); ++m)
+        for (int r = 0; r < iv->n_comp(); ++r) w[iv->theta(n, m, r)] = value;
+    iv->update_lifted_guess(w);
+  }
+}
+
 /// Time freezing: the clock state of the guess, where it violates the clock constraints (a
 /// constant guess), linear in tau from t(0) to t(0) + T, as if time never froze; with
 /// time_freezing_tolerance the guess at every interval end is then within the bounds.
@@ -719,6 +730,7 @@ OcpResult solve_impl(const Ocp& user, const OcpOptions& options, const std::vect
     guess_external(*b, ocp, p);
   else if (!simulated)
     guess_constant(*b, ocp, p);
+  if (options.initial_theta >= 0) guess_theta(*b, options.initial_theta);
   ocp_detail::guess_path_comp(*b, ocp, ocp.model.n_x(), ocp.model.n_u());
   if (ocp.time_freezing) guess_clock(*b, ocp);
   mp.finalize();

@@ -484,5 +484,36 @@ TEST(OcpElasticVariable, BoundFromTheFileReachesTheNlp) {
   }
 }
 
+// [ocp] initial_theta (nosnoc's initial_theta): every theta of the first guess set to one value
+// instead of the LP's. A guess only: the sliding-mode OCP reaches the same optimum, from another
+// first point (the first NLP takes another number of iterations). Out of [0, 1] (but -1), or with
+// the step form, it is refused naming the key.
+TEST(OcpInitialTheta, SetsTheGuessNotTheOptimum) {
+  OcpProblem q = example("nosnoc/ocp_sliding_mode_nosnoc.toml");
+  const OcpResult def = solve(q.ocp, q.options);
+  ASSERT_EQ(def.status, Status::Success) << def.message;
+  apply_override(q, "initial_theta", "0.5");
+  EXPECT_EQ(q.options.initial_theta, 0.5);
+  const OcpResult half = solve(q.ocp, q.options);
+  ASSERT_EQ(half.status, Status::Success) << half.message;
+  EXPECT_NEAR(half.objective, def.objective, 1e-6);
+  ASSERT_FALSE(half.homotopy.empty());
+  EXPECT_NE(half.homotopy.front().nlp_iterations, def.homotopy.front().nlp_iterations);
+  for (const char* bad : {"1.5", "-0.5"}) {
+    try {
+      apply_override(q, "initial_theta", bad);
+      ADD_FAILURE() << "initial_theta = " << bad << " accepted";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("initial_theta"), std::string::npos) << e.what();
+    }
+  }
+  try {
+    apply_override(q, "dcs_mode", "step");
+    ADD_FAILURE() << "initial_theta with dcs_mode = step accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("initial_theta"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace fesd
