@@ -450,9 +450,11 @@ void print_header(const fesd::OcpProblem& problem) {
                      problem.has_clock, ocp.x0, free_x0 ? " (free: the guess)" : "", ocp.p);
   print_solver_header(n_fe, o.discretization, o.homotopy, o.nlp);
   const fesd::OcpFunctions* f = ocp.functions.get();
-  out::print("  ocp         T = {:g}, N_stages = {} (control interval {:g}), initialization = {}\n",
+  out::print("  ocp         T = {:g}, N_stages = {} (control interval {:g}), initialization = {}",
              ocp.T, ocp.N_stages, ocp.N_stages > 0 ? ocp.T / ocp.N_stages : 0.0,
              fesd::to_string(o.initialization));
+  if (o.initial_theta >= 0) out::print(", initial_theta = {:g}", o.initial_theta);
+  out::print("\n");
   out::print("  cost        Lagrange term f_q: {}, Mayer term f_q_T: {}\n",
              f != nullptr && f->has_f_q() ? "yes" : "no",
              f != nullptr && f->has_f_q_T() ? "yes" : "no");
