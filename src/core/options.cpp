@@ -215,7 +215,7 @@ int homotopy_length(const HomotopyOptions& o) {
 double final_sigma(const HomotopyOptions& o) {
   // As the homotopy computes it.
   double sigma = o.sigma_0;
-  for (int k = 1; k < homotopy_length(o); ++k) sigma = next_sigma(o, sigma);
+  for (int k = 1, n = homotopy_length(o); k < n; ++k) sigma = next_sigma(o, sigma);
   return sigma;
 }
 
