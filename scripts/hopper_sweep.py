@@ -9,10 +9,13 @@
 Each point writes its variant with scripts/hopper_variant.py into a temporary directory, runs
 `fesd solve VARIANT --json OUT` and reads status, objective, IPOPT iterations and the CPU time of
 the NLPs (the sum over the homotopy, as nosnoc_py's cpu_time_nlp). It prints one row per point;
---csv writes them, --plot draws the scripts' two figures (CPU time, and CPU time per IPOPT
+--csv writes them, each as soon as its point has finished (a point takes 10-40 min of CPU time),
+and --resume keeps the rows already in that file and runs only the missing points, so a sweep
+can be run in pieces; --plot draws the scripts' two figures (CPU time, and CPU time per IPOPT
 iteration, over n_s or N, step form against Stewart's). Nothing is written unless asked.
 
   python3 scripts/hopper_sweep.py ns --points 2,3 --csv /tmp/ns.csv --plot /tmp/ns.png
+  python3 scripts/hopper_sweep.py ns --csv /tmp/ns.csv --resume      # the other points
 """
 import argparse
 import csv
@@ -83,7 +86,8 @@ def plot(rows, key, path):
     import matplotlib.pyplot as plt
     fig, axes = plt.subplots(1, 2, figsize=(9, 3.6))
     for form, style in (("step", "Xb-"), ("stewart", "Xr-")):
-        pts = [r for r in rows if r["form"] == form and r.get("cpu_nlp_s") is not None]
+        pts = sorted((r for r in rows if r["form"] == form and r.get("cpu_nlp_s") is not None),
+                     key=lambda r: r["value"])
         label = "Step" if form == "step" else "Stewart"
         axes[0].plot([r["value"] for r in pts], [r["cpu_nlp_s"] for r in pts], style, label=label)
         axes[1].plot([r["value"] for r in pts], [r["cpu_per_iteration_s"] for r in pts], style,
@@ -100,6 +104,27 @@ def plot(rows, key, path):
     fig.savefig(path, dpi=80)
 
 
+def read_rows(path, key):
+    """The rows of an earlier run's CSV (numbers back as numbers), for --resume."""
+    if not pathlib.Path(path).exists():
+        return []
+    rows = []
+    with open(path, newline="") as f:
+        for r in csv.DictReader(f):
+            if r.get("key") != key:
+                sys.exit(f"--resume: {path} holds a sweep over {r.get('key')}, not {key}")
+            r = {k: v for k, v in r.items() if v not in (None, "")}
+            r["value"] = int(r["value"])
+            for k in ("objective", "comp_residual", "cpu_nlp_s", "cpu_per_iteration_s", "wall_s"):
+                if k in r:
+                    r[k] = float(r[k])
+            for k in ("nlps", "ipopt_iterations"):
+                if k in r:
+                    r[k] = int(r[k])
+            rows.append(r)
+    return rows
+
+
 def main():
     a = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     a.add_argument("experiment", choices=sorted(EXPERIMENTS))
@@ -107,7 +132,9 @@ def main():
     a.add_argument("--forms", default="step,stewart", help="step, stewart or both (default)")
     a.add_argument("--fesd", default=str(ROOT / "build/fesd"))
     a.add_argument("--timeout", type=float, default=3600, help="seconds per point")
-    a.add_argument("--csv", help="write the rows as CSV")
+    a.add_argument("--csv", help="write the rows as CSV, each when its point has finished")
+    a.add_argument("--resume", action="store_true",
+                   help="keep the rows of --csv's file and run only the points not in it")
     a.add_argument("--plot", help="draw the scripts' two figures (PNG/SVG)")
     args = a.parse_args()
     key, points, flags, no_guess = EXPERIMENTS[args.experiment]
@@ -128,11 +155,25 @@ def main():
     if not pathlib.Path(args.fesd).exists():
         a.error(f"no fesd binary at {args.fesd} (build it or pass --fesd)")
     rows = []
+    if args.resume:
+        if not args.csv:
+            a.error("--resume needs --csv")
+        rows = read_rows(args.csv, key)
+    done = {(r["form"], r["value"]) for r in rows}
+    writer = None
+    if args.csv:
+        existing = args.resume and pathlib.Path(args.csv).exists()
+        csv_file = open(args.csv, "a" if existing else "w", newline="")
+        writer = csv.DictWriter(csv_file, fieldnames=FIELDS)
+        if not existing:
+            writer.writeheader()
     print("%-8s %4s %-24s %12s %9s %5s %6s %9s %8s" % ("form", key[:4], "status", "objective",
           "comp", "NLPs", "iter", "CPU s", "s/iter"), flush=True)
     with tempfile.TemporaryDirectory() as directory:
         for value in points:
             for form in forms:
+                if (form, value) in done:
+                    continue
                 r = run_point(args.fesd, form, key, value, flags, no_guess[form], args.timeout,
                               directory)
                 rows.append(r)
@@ -141,11 +182,11 @@ def main():
                     "%.1e" % r["comp_residual"] if "comp_residual" in r else "-",
                     r.get("nlps", "-"), r.get("ipopt_iterations", "-"), r.get("cpu_nlp_s", "-"),
                     r.get("cpu_per_iteration_s", "-")), flush=True)
-    if args.csv:
-        with open(args.csv, "w", newline="") as f:
-            w = csv.DictWriter(f, fieldnames=FIELDS)
-            w.writeheader()
-            w.writerows(rows)
+                if writer:
+                    writer.writerow(r)
+                    csv_file.flush()
+    if writer:
+        csv_file.close()
     if args.plot:
         plot(rows, key, args.plot)
 
