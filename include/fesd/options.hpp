@@ -128,6 +128,16 @@ enum class MpccMode {
 /// "ell_1_penalty", "elastic_ineq", "elastic_two_sided".
 std::string_view to_string(MpccMode v);
 bool parse(std::string_view name, MpccMode& out);
+/// elastic_ineq or elastic_two_sided: the modes with the elastic variable s
+/// (HomotopyOptions::s_elastic_max, s_elastic_0).
+constexpr bool is_elastic(MpccMode m) {
+  return m == MpccMode::ElasticIneq || m == MpccMode::ElasticTwoSided;
+}
+/// The modes that put a penalty term in the objective (ell_1_penalty and the elastic modes):
+/// those that HomotopyOptions::objective_scaling_direct applies to.
+constexpr bool penalizes(MpccMode m) {
+  return m == MpccMode::L1Penalty || is_elastic(m);
+}
 
 /// How sigma shrinks from one NLP of the homotopy to the next (nosnoc's homotopy_update_rule).
 enum class HomotopyUpdateRule {

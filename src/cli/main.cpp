@@ -387,11 +387,9 @@ void print_solver_header(const std::string& n_fe, const fesd::DiscretizationOpti
                h.homotopy_update_exponent);
   out::print("sigma_N = {:g}, complementarity_tol = {:g}, N_homotopy = {}", h.sigma_N,
              h.complementarity_tol, h.max_homotopy_steps);
-  const bool elastic =
-      h.mpcc_mode == fesd::MpccMode::ElasticIneq || h.mpcc_mode == fesd::MpccMode::ElasticTwoSided;
-  if (elastic)
+  if (fesd::is_elastic(h.mpcc_mode))
     out::print(", s_elastic_max = {:g}, s_elastic_0 = {:g}", h.s_elastic_max, h.s_elastic_0);
-  if (!h.objective_scaling_direct && (elastic || h.mpcc_mode == fesd::MpccMode::L1Penalty))
+  if (!h.objective_scaling_direct && fesd::penalizes(h.mpcc_mode))
     out::print(", objective_scaling_direct = false (sigma J + P)");
   out::print("\n");
   out::print("  ipopt       tol = {:g}, acceptable_tol = {:g}, max_iter = {}, print_level = {}",

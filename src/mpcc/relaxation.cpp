@@ -128,7 +128,7 @@ Relaxation::Relaxation(nlp::BlockNlp& nlp, const std::vector<CompGroup>& groups,
   // keep one layout.
   if (mode == MpccMode::FischerBurmeister)  // sigma enters the rows as a variable fixed by bounds
     sigma_var_ = nlp.add_variables(1, 1.0, 1.0, 1.0);  // IPOPT removes it (make_parameter)
-  const bool elastic = mode == MpccMode::ElasticIneq || mode == MpccMode::ElasticTwoSided;
+  const bool elastic = is_elastic(mode);
   if (elastic) elastic_var_ = nlp.add_variables(1, 0.0, s_max, s_0);
 
   for (std::size_t k = 0; k < groups.size(); ++k) {

@@ -30,6 +30,7 @@
 #include "ocp/ocp_checks.hpp"
 #include "ocp/ocp_input.hpp"
 #include "ocp/ocp_terms.hpp"
+#include "ocp/resolve_account.hpp"
 #include "ocp/speed_of_time.hpp"
 
 namespace fesd {
@@ -46,6 +47,7 @@ using ocp_detail::control_guess;
 using ocp_detail::LagrangeTerm;
 using ocp_detail::MayerTerm;
 using ocp_detail::range;
+using ocp_detail::ResolveAccount;
 using ocp_detail::StageParameters;
 using ocp_detail::TerminalConstraintEq;
 
@@ -385,12 +387,14 @@ std::function<bool(mpcc::HomotopyResult&)> early_active_set_finish(OcpNlp& b, co
 }
 
 /// Solves the last NLP once more from `start` with `bounds` (active sets fixed). The result is
-/// kept if it converges and keep(its cost) holds; else the point before is restored.
-template <class Account, class Keep>
+/// kept if it converges and keep(its cost) holds; else the point before is restored. Nothing is
+/// solved (false) once the account is exhausted.
+template <class Keep>
 bool try_resolve(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const StageParameters& p,
-                 nlp::NlpSolver& solver, const Account& account, mpcc::HomotopyResult& hr,
+                 nlp::NlpSolver& solver, const ResolveAccount& account, mpcc::HomotopyResult& hr,
                  const std::vector<double>& start, const std::vector<nlp::Bound>& bounds,
                  int n_pins, const Keep& keep) {
+  if (account.exhausted()) return false;
   mpcc::Problem& mp = b.mpcc;
   const nlp::Iterate before = mp.iterate();
   const mpcc::HomotopyResult again = mp.solve_again(solver, o.homotopy, bounds, n_pins, &start);
@@ -411,10 +415,9 @@ bool try_resolve(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const StagePara
 /// freely again). A round is kept if it converges and does not raise the cost; at most
 /// kMaxGridMoves rounds (each one at least doubles how far a held switch can go). Switches still
 /// held at the end are counted and named in a warning.
-template <class Account>
 void move_held_switches(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const StageParameters& p,
-                        nlp::NlpSolver& solver, const Account& account, mpcc::HomotopyResult& hr,
-                        Summary& summary) {
+                        nlp::NlpSolver& solver, const ResolveAccount& account,
+                        mpcc::HomotopyResult& hr, Summary& summary) {
   constexpr int kMaxGridMoves = 8;
   for (int round = 0; round < kMaxGridMoves; ++round) {
     const std::vector<double> w = b.mpcc.solution();
@@ -442,9 +445,8 @@ void move_held_switches(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const St
 /// (FesdInterval::touches) is probed: the element after it in the other region, solved with
 /// every active set fixed; kept if the cost falls, then held switches are moved again. At most
 /// kMaxProbes NLPs.
-template <class Account>
 void probe_touches(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const StageParameters& p,
-                   nlp::NlpSolver& solver, const Account& account, mpcc::HomotopyResult& hr,
+                   nlp::NlpSolver& solver, const ResolveAccount& account, mpcc::HomotopyResult& hr,
                    Summary& summary) {
   constexpr int kMaxProbes = 4;
   mpcc::Problem& mp = b.mpcc;
@@ -482,11 +484,10 @@ void probe_touches(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const StagePa
 /// (the new quadrature of the old trajectory) predicts the move: it is solved only if that cost is
 /// lower, or if the regrid had to move the switch (an h bound). Kept (true) if it converges and
 /// lowers the cost.
-template <class Account>
 bool try_allocation_move(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const StageParameters& p,
-                         nlp::NlpSolver& solver, const Account& account, mpcc::HomotopyResult& hr,
-                         std::size_t k, std::size_t j, const std::vector<int>& count,
-                         Summary& summary) {
+                         nlp::NlpSolver& solver, const ResolveAccount& account,
+                         mpcc::HomotopyResult& hr, std::size_t k, std::size_t j,
+                         const std::vector<int>& count, Summary& summary) {
   const FesdInterval& iv = *b.iv[k];
   const std::vector<double> w = b.mpcc.solution();
   if (j >= count.size()) return false;
@@ -502,6 +503,7 @@ bool try_allocation_move(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const S
   };
   const bool moved = std::abs(switch_time(w) - switch_time(start)) > 1e-9 * ocp.T;
   if (!moved && cost(b, ocp, start, p) >= cost_before - slack) return false;
+  if (account.exhausted()) return false;
   std::vector<nlp::Bound> bounds;
   const int n_pins = fix_active_sets(b, start, o.discretization.pin_sliding_exits,
                                      /*every_interval=*/true, bounds);
@@ -520,10 +522,9 @@ bool try_allocation_move(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const S
 /// re-gridded point predicts a gain (try_allocation_move), so a scheme whose quadrature is exact
 /// for the problem costs none. Only with step_eq = l2_relaxed: the other penalties pull every h_n
 /// to h0 (heuristic_*) and so decide the allocation themselves, or are not the default.
-template <class Account>
 void search_allocation(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const StageParameters& p,
-                       nlp::NlpSolver& solver, const Account& account, mpcc::HomotopyResult& hr,
-                       Summary& summary) {
+                       nlp::NlpSolver& solver, const ResolveAccount& account,
+                       mpcc::HomotopyResult& hr, Summary& summary) {
   if (o.discretization.step_eq != StepEq::L2Relaxed) return;
   int budget = 0, n_switches = 0;
   {
@@ -578,10 +579,9 @@ void search_allocation(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Sta
 /// The allocation `count` in every interval (ocp_detail::solve_allocation): re-grid, then solve
 /// the last NLP with every active set fixed; the result kept whatever its cost. False (the point
 /// before restored) if an interval cannot be re-gridded or the re-solve fails.
-template <class Account>
 bool force_allocation(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const StageParameters& p,
-                      nlp::NlpSolver& solver, const Account& account, mpcc::HomotopyResult& hr,
-                      const std::vector<int>& count, Summary& summary) {
+                      nlp::NlpSolver& solver, const ResolveAccount& account,
+                      mpcc::HomotopyResult& hr, const std::vector<int>& count, Summary& summary) {
   const std::vector<double> w = b.mpcc.solution();
   std::vector<double> start = w;
   for (const auto& iv : b.iv)
@@ -740,9 +740,8 @@ OcpResult solve_impl(const Ocp& user, const OcpOptions& options, const std::vect
   res.summary.setup_s = seconds_since(t_start);
 
   const std::unique_ptr<nlp::NlpSolver> solver = nlp::make_solver(options.nlp);
-  auto account = [&](const mpcc::HomotopyResult& h) {
-    mpcc::add_to_summary(h, res.summary, res.homotopy);
-  };
+  int failed_in_a_row = 0;
+  const ResolveAccount account{res.summary, res.homotopy, failed_in_a_row};
   bool finished_early = false;
   const auto finish = early_active_set_finish(*b, options, *solver, res.summary, finished_early);
   mpcc::HomotopyResult hr = mp.solve_homotopy(*solver, options.homotopy, options.on_homotopy_row,
@@ -779,6 +778,12 @@ OcpResult solve_impl(const Ocp& user, const OcpOptions& options, const std::vect
     move_held_switches(*b, ocp, options, p, *solver, account, hr, res.summary);
     probe_touches(*b, ocp, options, p, *solver, account, hr, res.summary);
     search_allocation(*b, ocp, options, p, *solver, account, hr, res.summary);
+    if (account.exhausted())
+      res.summary.warnings.push_back(fmt::format(
+          "the last {} re-solves with the active set fixed did not converge; the remaining ones "
+          "(held switches, touches, the allocation search) were skipped",
+          ResolveAccount::kMaxFailedInARow));
+    failed_in_a_row = 0;  // an allocation asked for is always tried
     if (count != nullptr)
       *applied = force_allocation(*b, ocp, options, p, *solver, account, hr, *count, res.summary);
     report_held_switches(*b, mp.solution(), res.summary);

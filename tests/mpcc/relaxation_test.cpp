@@ -95,11 +95,22 @@ INSTANTIATE_TEST_SUITE_P(Modes, TinyMpcc, ::testing::ValuesIn(kAllModes), mode_n
 // sigma J + P instead of J + (1/sigma) P, i.e. exactly sigma times it, at every point and sigma,
 // with the gradient scaled alike; modes without a penalty term ignore the setting. On the
 // two-variable MPCC both scalings reach the start's minimizer (1, 0).
+// The mode classes that the relaxation, the CLI header and these tests share.
+static_assert(fesd::is_elastic(MpccMode::ElasticIneq) &&
+              fesd::is_elastic(MpccMode::ElasticTwoSided));
+static_assert(!fesd::is_elastic(MpccMode::ScholtesIneq) &&
+              !fesd::is_elastic(MpccMode::ScholtesEq) &&
+              !fesd::is_elastic(MpccMode::FischerBurmeister) &&
+              !fesd::is_elastic(MpccMode::L1Penalty));
+static_assert(fesd::penalizes(MpccMode::L1Penalty) && fesd::penalizes(MpccMode::ElasticIneq) &&
+              fesd::penalizes(MpccMode::ElasticTwoSided));
+static_assert(!fesd::penalizes(MpccMode::ScholtesIneq) && !fesd::penalizes(MpccMode::ScholtesEq) &&
+              !fesd::penalizes(MpccMode::FischerBurmeister));
+
 TEST(ObjectiveScaling, InverseIsSigmaTimesDirect) {
   const std::vector<double> point{0.7, 0.3, 0.25};  // x, y, and s where a mode has it
   for (MpccMode mode : kAllModes) {
-    const bool penalty = mode == MpccMode::L1Penalty || mode == MpccMode::ElasticIneq ||
-                         mode == MpccMode::ElasticTwoSided;
+    const bool penalty = fesd::penalizes(mode);
     fesd::nlp::BlockNlp nlps[2];
     std::vector<fesd::mpcc::Relaxation> relaxations;
     for (const bool direct : {true, false}) {
@@ -566,8 +577,7 @@ TEST_P(TwoSided, StayScholtesRowsInEveryMode) {
   } else {
     EXPECT_EQ(relaxation.sigma_variable(), -1);
   }
-  EXPECT_EQ(relaxation.elastic_variable() >= 0,
-            mode == MpccMode::ElasticIneq || mode == MpccMode::ElasticTwoSided);
+  EXPECT_EQ(relaxation.elastic_variable() >= 0, fesd::is_elastic(mode));
 }
 INSTANTIATE_TEST_SUITE_P(Modes, TwoSided, ::testing::ValuesIn(kAllModes), mode_name);
 

@@ -14,6 +14,7 @@
 #include <fesd/ocp.hpp>
 
 #include "../../bench/sensitivity_ocp.hpp"
+#include "ocp/resolve_account.hpp"
 
 namespace {
 
@@ -102,6 +103,35 @@ TEST(AllocationSearchExactQuadrature, SolvesNothing) {
   ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
   EXPECT_NEAR(r.x0()[0], fesd_bench::kSensitivityX0Star, 1e-6);
   EXPECT_EQ(r.summary.allocation_solves, 0);
+}
+
+// The re-solves after the homotopy give up after three in a row that did not converge (a
+// converged one resets the count, whatever its cost); every one is booked. (Row 30 of
+// docs/nosnoc-examples.md: 3 re-solves instead of 5, the same result.)
+TEST(ResolveAccount, GivesUpAfterThreeFailuresInARow) {
+  fesd::Summary summary;
+  std::vector<fesd::HomotopyRow> rows;
+  int failed = 0;
+  const fesd::ocp_detail::ResolveAccount account{summary, rows, failed};
+  auto resolve = [&](fesd::Status status) {
+    fesd::mpcc::HomotopyResult h;
+    h.status = status;
+    h.rows.resize(1);
+    h.nlp_iterations = 100;
+    account(h);
+  };
+  resolve(fesd::Status::NlpFailed);
+  resolve(fesd::Status::ComplementarityNotMet);
+  EXPECT_FALSE(account.exhausted());
+  resolve(fesd::Status::Success);  // converged: the count starts again
+  resolve(fesd::Status::NlpFailed);
+  resolve(fesd::Status::EvaluationFailed);
+  EXPECT_FALSE(account.exhausted());
+  resolve(fesd::Status::NlpFailed);
+  EXPECT_TRUE(account.exhausted());
+  EXPECT_EQ(rows.size(), 6u);
+  EXPECT_EQ(summary.homotopy_steps, 6);
+  EXPECT_EQ(summary.nlp_iterations, 600);
 }
 
 }  // namespace
