@@ -237,7 +237,8 @@ struct NlpOptions {
   int print_level = 0;           ///< `print_level` 0..12 (IPOPT's own output)
   /// `kkt_solver`: IPOPT's linear solver. An IPOPT `linear_solver` in `extra` overrides it. With
   /// sparse_ldl (also under auto) an NLP that fails is solved again with MUMPS from the same
-  /// start, and NlpResult::linear_solver says "mumps (sparse_ldl fallback)".
+  /// start, and HomotopyRow::linear_solver says "mumps (sparse_ldl fallback: STATUS after N
+  /// iterations)".
   KktSolver kkt_solver = KktSolver::Auto;
   /// Extra IPOPT options as (name, value) strings, e.g. {"mu_strategy", "monotone"}.
   std::vector<std::pair<std::string, std::string>> extra;

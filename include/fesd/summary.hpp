@@ -25,7 +25,8 @@ struct HomotopyRow {
   std::string nlp_status;  ///< IPOPT's return status, e.g. "Solve_Succeeded"
   double cpu_s = 0;
   /// KKT solver IPOPT used: "dense" (LAPACK LDL', small NLPs), "sparse_ldl", "mumps", or "mumps
-  /// (sparse_ldl fallback)" (NlpOptions::kkt_solver).
+  /// (sparse_ldl fallback: STATUS after N iterations)" (NlpOptions::kkt_solver; nlp_iterations
+  /// and cpu_s then count both runs, factor_s and factorizations MUMPS's).
   std::string linear_solver;
   /// Wall time of IPOPT's KKT factorizations, and their number with fesd's sparse LDL' (0 else).
   double factor_s = 0;

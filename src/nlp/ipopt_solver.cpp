@@ -363,11 +363,13 @@ NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_star
   auto [r, s] = run(mode);
   r.linear_solver = name;
   if (may_retry && !r.success && !r.eval_error && retry_with_mumps(s)) {
-    const double eval_s = r.eval_s;
+    const NlpResult first = r;
     start = start_copy;
     r = run(-1).first;
-    r.eval_s += eval_s;
-    r.linear_solver = "mumps (sparse_ldl fallback)";
+    r.eval_s += first.eval_s;
+    r.iterations += first.iterations;
+    r.linear_solver = fmt::format("mumps (sparse_ldl fallback: {} after {} iterations)",
+                                  first.status, first.iterations);
   }
   r.total_s = seconds_since(t0);
   return r;

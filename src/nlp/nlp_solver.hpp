@@ -22,10 +22,11 @@ struct NlpResult {
   bool eval_error = false;  ///< stopped because evaluations kept failing (NaN/inf)
   std::string status;       ///< backend status name, e.g. "Solve_Succeeded"
   /// KKT solver that produced the result: "dense" (LAPACK LDL'), "sparse_ldl", "mumps", "mumps
-  /// (sparse_ldl fallback)" (sparse_ldl failed, MUMPS solved again from the same start), or
-  /// IPOPT's linear_solver when the caller set that.
+  /// (sparse_ldl fallback: STATUS after N iterations)" (sparse_ldl failed with IPOPT's STATUS
+  /// after N iterations, MUMPS solved again from the same start), or IPOPT's linear_solver when
+  /// the caller set that.
   std::string linear_solver;
-  int iterations = 0;
+  int iterations = 0;  ///< IPOPT iterations; after a fallback those of both runs
   double objective = 0, inf_pr = 0, inf_du = 0;
   double eval_s = 0;   ///< time spent in function and derivative evaluations
   double total_s = 0;  ///< wall time of the whole solve
