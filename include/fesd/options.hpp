@@ -236,9 +236,9 @@ struct NlpOptions {
   int max_iter = 500;            ///< `max_iter` >= 1, per NLP
   int print_level = 0;           ///< `print_level` 0..12 (IPOPT's own output)
   /// `kkt_solver`: IPOPT's linear solver. An IPOPT `linear_solver` in `extra` overrides it. With
-  /// sparse_ldl (also under auto) an NLP that fails is solved again with MUMPS from the same
-  /// start, and HomotopyRow::linear_solver says "mumps (sparse_ldl fallback: STATUS after N
-  /// iterations)".
+  /// sparse_ldl (also under auto) an NLP that fails is solved again from the same start, first
+  /// with sparse_ldl and ma27_pivtol 0.01 (unless [ipopt] sets a larger one), then, if that
+  /// fails too, with MUMPS; HomotopyRow::linear_solver names the runs.
   KktSolver kkt_solver = KktSolver::Auto;
   /// Extra IPOPT options as (name, value) strings, e.g. {"mu_strategy", "monotone"}.
   std::vector<std::pair<std::string, std::string>> extra;

@@ -21,12 +21,13 @@ struct NlpResult {
   bool success = false;     ///< converged (to tol or acceptable_tol)
   bool eval_error = false;  ///< stopped because evaluations kept failing (NaN/inf)
   std::string status;       ///< backend status name, e.g. "Solve_Succeeded"
-  /// KKT solver that produced the result: "dense" (LAPACK LDL'), "sparse_ldl", "mumps", "mumps
-  /// (sparse_ldl fallback: STATUS after N iterations)" (sparse_ldl failed with IPOPT's STATUS
-  /// after N iterations, MUMPS solved again from the same start), or IPOPT's linear_solver when
-  /// the caller set that.
+  /// KKT solver that produced the result: "dense" (LAPACK LDL'), "sparse_ldl", "sparse_ldl
+  /// (again with ma27_pivtol 0.01; first run: STATUS after N iterations)" (the first sparse_ldl run
+  /// failed, the second from the same start with stricter pivoting is the result), "mumps
+  /// (sparse_ldl fallback: ...)" (both sparse_ldl runs failed as listed, MUMPS solved again from
+  /// the same start), "mumps", or IPOPT's linear_solver when the caller set that.
   std::string linear_solver;
-  int iterations = 0;  ///< IPOPT iterations; after a fallback those of both runs
+  int iterations = 0;  ///< IPOPT iterations; after a retry or fallback those of every run
   double objective = 0, inf_pr = 0, inf_du = 0;
   double eval_s = 0;   ///< time spent in function and derivative evaluations
   double total_s = 0;  ///< wall time of the whole solve
