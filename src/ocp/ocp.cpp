@@ -394,7 +394,7 @@ bool try_resolve(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const StagePara
                  nlp::NlpSolver& solver, const ResolveAccount& account, mpcc::HomotopyResult& hr,
                  const std::vector<double>& start, const std::vector<nlp::Bound>& bounds,
                  int n_pins, const Keep& keep) {
-  if (account.exhausted()) return false;
+  if (account.skip()) return false;
   mpcc::Problem& mp = b.mpcc;
   const nlp::Iterate before = mp.iterate();
   const mpcc::HomotopyResult again = mp.solve_again(solver, o.homotopy, bounds, n_pins, &start);
@@ -503,7 +503,7 @@ bool try_allocation_move(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const S
   };
   const bool moved = std::abs(switch_time(w) - switch_time(start)) > 1e-9 * ocp.T;
   if (!moved && cost(b, ocp, start, p) >= cost_before - slack) return false;
-  if (account.exhausted()) return false;
+  if (account.skip()) return false;
   std::vector<nlp::Bound> bounds;
   const int n_pins = fix_active_sets(b, start, o.discretization.pin_sliding_exits,
                                      /*every_interval=*/true, bounds);
@@ -740,8 +740,8 @@ OcpResult solve_impl(const Ocp& user, const OcpOptions& options, const std::vect
   res.summary.setup_s = seconds_since(t_start);
 
   const std::unique_ptr<nlp::NlpSolver> solver = nlp::make_solver(options.nlp);
-  int failed_in_a_row = 0;
-  const ResolveAccount account{res.summary, res.homotopy, failed_in_a_row};
+  int failed_in_a_row = 0, skipped = 0;
+  const ResolveAccount account{res.summary, res.homotopy, failed_in_a_row, skipped};
   bool finished_early = false;
   const auto finish = early_active_set_finish(*b, options, *solver, res.summary, finished_early);
   mpcc::HomotopyResult hr = mp.solve_homotopy(*solver, options.homotopy, options.on_homotopy_row,
@@ -778,11 +778,11 @@ OcpResult solve_impl(const Ocp& user, const OcpOptions& options, const std::vect
     move_held_switches(*b, ocp, options, p, *solver, account, hr, res.summary);
     probe_touches(*b, ocp, options, p, *solver, account, hr, res.summary);
     search_allocation(*b, ocp, options, p, *solver, account, hr, res.summary);
-    if (account.exhausted())
+    if (skipped > 0)
       res.summary.warnings.push_back(fmt::format(
-          "the last {} re-solves with the active set fixed did not converge; the remaining ones "
-          "(held switches, touches, the allocation search) were skipped",
-          ResolveAccount::kMaxFailedInARow));
+          "{} re-solves with the active set fixed in a row did not converge; {} more (held "
+          "switches, touches, the allocation search) were skipped",
+          ResolveAccount::kMaxFailedInARow, skipped));
     failed_in_a_row = 0;  // an allocation asked for is always tried
     if (count != nullptr)
       *applied = force_allocation(*b, ocp, options, p, *solver, account, hr, *count, res.summary);

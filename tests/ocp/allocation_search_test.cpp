@@ -111,8 +111,8 @@ TEST(AllocationSearchExactQuadrature, SolvesNothing) {
 TEST(ResolveAccount, GivesUpAfterThreeFailuresInARow) {
   fesd::Summary summary;
   std::vector<fesd::HomotopyRow> rows;
-  int failed = 0;
-  const fesd::ocp_detail::ResolveAccount account{summary, rows, failed};
+  int failed = 0, skipped = 0;
+  const fesd::ocp_detail::ResolveAccount account{summary, rows, failed, skipped};
   auto resolve = [&](fesd::Status status) {
     fesd::mpcc::HomotopyResult h;
     h.status = status;
@@ -127,8 +127,12 @@ TEST(ResolveAccount, GivesUpAfterThreeFailuresInARow) {
   resolve(fesd::Status::NlpFailed);
   resolve(fesd::Status::EvaluationFailed);
   EXPECT_FALSE(account.exhausted());
+  EXPECT_FALSE(account.skip());
   resolve(fesd::Status::NlpFailed);
   EXPECT_TRUE(account.exhausted());
+  EXPECT_TRUE(account.skip());
+  EXPECT_TRUE(account.skip());
+  EXPECT_EQ(skipped, 2);
   EXPECT_EQ(rows.size(), 6u);
   EXPECT_EQ(summary.homotopy_steps, 6);
   EXPECT_EQ(summary.nlp_iterations, 600);
