@@ -391,7 +391,7 @@ std::function<bool(mpcc::HomotopyResult&)> early_active_set_finish(OcpNlp& b, co
 /// solved (false) once the account is exhausted.
 template <class Keep>
 bool try_resolve(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const StageParameters& p,
-                 nlp::NlpSolver& solver, const ResolveAccount& account, mpcc::HomotopyResult& hr,
+                 nlp::NlpSolver& solver, ResolveAccount& account, mpcc::HomotopyResult& hr,
                  const std::vector<double>& start, const std::vector<nlp::Bound>& bounds,
                  int n_pins, const Keep& keep) {
   if (account.skip()) return false;
@@ -416,8 +416,8 @@ bool try_resolve(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const StagePara
 /// kMaxGridMoves rounds (each one at least doubles how far a held switch can go). Switches still
 /// held at the end are counted and named in a warning.
 void move_held_switches(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const StageParameters& p,
-                        nlp::NlpSolver& solver, const ResolveAccount& account,
-                        mpcc::HomotopyResult& hr, Summary& summary) {
+                        nlp::NlpSolver& solver, ResolveAccount& account, mpcc::HomotopyResult& hr,
+                        Summary& summary) {
   constexpr int kMaxGridMoves = 8;
   for (int round = 0; round < kMaxGridMoves; ++round) {
     const std::vector<double> w = b.mpcc.solution();
@@ -446,7 +446,7 @@ void move_held_switches(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const St
 /// every active set fixed; kept if the cost falls, then held switches are moved again. At most
 /// kMaxProbes NLPs.
 void probe_touches(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const StageParameters& p,
-                   nlp::NlpSolver& solver, const ResolveAccount& account, mpcc::HomotopyResult& hr,
+                   nlp::NlpSolver& solver, ResolveAccount& account, mpcc::HomotopyResult& hr,
                    Summary& summary) {
   constexpr int kMaxProbes = 4;
   mpcc::Problem& mp = b.mpcc;
@@ -485,9 +485,9 @@ void probe_touches(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const StagePa
 /// lower, or if the regrid had to move the switch (an h bound). Kept (true) if it converges and
 /// lowers the cost.
 bool try_allocation_move(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const StageParameters& p,
-                         nlp::NlpSolver& solver, const ResolveAccount& account,
-                         mpcc::HomotopyResult& hr, std::size_t k, std::size_t j,
-                         const std::vector<int>& count, Summary& summary) {
+                         nlp::NlpSolver& solver, ResolveAccount& account, mpcc::HomotopyResult& hr,
+                         std::size_t k, std::size_t j, const std::vector<int>& count,
+                         Summary& summary) {
   const FesdInterval& iv = *b.iv[k];
   const std::vector<double> w = b.mpcc.solution();
   if (j >= count.size()) return false;
@@ -523,8 +523,8 @@ bool try_allocation_move(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const S
 /// for the problem costs none. Only with step_eq = l2_relaxed: the other penalties pull every h_n
 /// to h0 (heuristic_*) and so decide the allocation themselves, or are not the default.
 void search_allocation(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const StageParameters& p,
-                       nlp::NlpSolver& solver, const ResolveAccount& account,
-                       mpcc::HomotopyResult& hr, Summary& summary) {
+                       nlp::NlpSolver& solver, ResolveAccount& account, mpcc::HomotopyResult& hr,
+                       Summary& summary) {
   if (o.discretization.step_eq != StepEq::L2Relaxed) return;
   int budget = 0, n_switches = 0;
   {
@@ -580,8 +580,8 @@ void search_allocation(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const Sta
 /// the last NLP with every active set fixed; the result kept whatever its cost. False (the point
 /// before restored) if an interval cannot be re-gridded or the re-solve fails.
 bool force_allocation(OcpNlp& b, const Ocp& ocp, const OcpOptions& o, const StageParameters& p,
-                      nlp::NlpSolver& solver, const ResolveAccount& account,
-                      mpcc::HomotopyResult& hr, const std::vector<int>& count, Summary& summary) {
+                      nlp::NlpSolver& solver, ResolveAccount& account, mpcc::HomotopyResult& hr,
+                      const std::vector<int>& count, Summary& summary) {
   const std::vector<double> w = b.mpcc.solution();
   std::vector<double> start = w;
   for (const auto& iv : b.iv)
@@ -740,8 +740,7 @@ OcpResult solve_impl(const Ocp& user, const OcpOptions& options, const std::vect
   res.summary.setup_s = seconds_since(t_start);
 
   const std::unique_ptr<nlp::NlpSolver> solver = nlp::make_solver(options.nlp);
-  int failed_in_a_row = 0, skipped = 0;
-  const ResolveAccount account{res.summary, res.homotopy, failed_in_a_row, skipped};
+  ResolveAccount account{res.summary, res.homotopy};
   bool finished_early = false;
   const auto finish = early_active_set_finish(*b, options, *solver, res.summary, finished_early);
   mpcc::HomotopyResult hr = mp.solve_homotopy(*solver, options.homotopy, options.on_homotopy_row,
@@ -778,12 +777,12 @@ OcpResult solve_impl(const Ocp& user, const OcpOptions& options, const std::vect
     move_held_switches(*b, ocp, options, p, *solver, account, hr, res.summary);
     probe_touches(*b, ocp, options, p, *solver, account, hr, res.summary);
     search_allocation(*b, ocp, options, p, *solver, account, hr, res.summary);
-    if (skipped > 0)
+    if (account.skipped > 0)
       res.summary.warnings.push_back(fmt::format(
           "{} re-solves with the active set fixed in a row did not converge; {} more (held "
           "switches, touches, the allocation search) were skipped",
-          ResolveAccount::kMaxFailedInARow, skipped));
-    failed_in_a_row = 0;  // an allocation asked for is always tried
+          ResolveAccount::kMaxFailedInARow, account.skipped));
+    account.failed_in_a_row = 0;  // an allocation asked for is always tried
     if (count != nullptr)
       *applied = force_allocation(*b, ocp, options, p, *solver, account, hr, *count, res.summary);
     report_held_switches(*b, mp.solution(), res.summary);

@@ -18,15 +18,15 @@ struct ResolveAccount {
   static constexpr int kMaxFailedInARow = 3;
   Summary& summary;
   std::vector<HomotopyRow>& rows;
-  int& failed_in_a_row;
-  int& skipped;
-  void operator()(const mpcc::HomotopyResult& h) const {
+  int failed_in_a_row = 0;
+  int skipped = 0;
+  void operator()(const mpcc::HomotopyResult& h) {
     mpcc::add_to_summary(h, summary, rows);
     failed_in_a_row = h.status == Status::Success ? 0 : failed_in_a_row + 1;
   }
   bool exhausted() const { return failed_in_a_row >= kMaxFailedInARow; }
   /// True (and the re-solve counted as skipped) if the account is exhausted.
-  bool skip() const {
+  bool skip() {
     if (!exhausted()) return false;
     ++skipped;
     return true;

@@ -111,8 +111,7 @@ TEST(AllocationSearchExactQuadrature, SolvesNothing) {
 TEST(ResolveAccount, GivesUpAfterThreeFailuresInARow) {
   fesd::Summary summary;
   std::vector<fesd::HomotopyRow> rows;
-  int failed = 0, skipped = 0;
-  const fesd::ocp_detail::ResolveAccount account{summary, rows, failed, skipped};
+  fesd::ocp_detail::ResolveAccount account{summary, rows};
   auto resolve = [&](fesd::Status status) {
     fesd::mpcc::HomotopyResult h;
     h.status = status;
@@ -132,7 +131,7 @@ TEST(ResolveAccount, GivesUpAfterThreeFailuresInARow) {
   EXPECT_TRUE(account.exhausted());
   EXPECT_TRUE(account.skip());
   EXPECT_TRUE(account.skip());
-  EXPECT_EQ(skipped, 2);
+  EXPECT_EQ(account.skipped, 2);
   EXPECT_EQ(rows.size(), 6u);
   EXPECT_EQ(summary.homotopy_steps, 6);
   EXPECT_EQ(summary.nlp_iterations, 600);
