@@ -207,7 +207,7 @@ const KktModule& kkt_module() {
 /// The second sparse_ldl run of an NLP whose first failed (IpoptSolver::solve): IPOPT's
 /// ma27_pivtol (CNTL(1): a pivot is accepted if at least u times its column's largest entry) and
 /// the most IPOPT may raise it to. IPOPT's defaults are 1e-8 and 1e-4. Measured on
-/// examples/nosnoc/hopper_exercise_ocp_step.toml (docs/kkt-solver.md, "A second sparse_ldl run"):
+/// examples/nosnoc/hopper_exercise_ocp_step.toml (docs/kkt-solver.md, "Retry, then fallback"):
 /// NLP 4's first run ends Restoration_Failed after 563 iterations; again with 1e-2 it solves in
 /// 434 (with 1e-4: 883), where MUMPS took 382 at 4-5 times the cost per iteration.
 constexpr double kRetryPivtol = 1e-2;
@@ -378,8 +378,8 @@ NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_star
   if (may_retry && !r.success && !r.eval_error && retry_with_mumps(s)) {
     std::string tried = fmt::format("{} after {} iterations", r.status, r.iterations);
     double pivtol = 1e-8, pivtolmax = 1e-4;  // IPOPT's defaults, unless set in [ipopt]
-    if (!app.Options()->GetNumericValue("ma27_pivtol", pivtol, "")) pivtol = 1e-8;
-    if (!app.Options()->GetNumericValue("ma27_pivtolmax", pivtolmax, "")) pivtolmax = 1e-4;
+    app.Options()->GetNumericValue("ma27_pivtol", pivtol, "");
+    app.Options()->GetNumericValue("ma27_pivtolmax", pivtolmax, "");
     if (pivtol < kRetryPivtol) {
       const NlpResult first = r;
       start = start_copy;

@@ -91,10 +91,6 @@ INSTANTIATE_TEST_SUITE_P(Modes, TinyMpcc, ::testing::ValuesIn(kAllModes), mode_n
 
 // ---- objective_scaling_direct ------------------------------------------------------------
 
-// nosnoc's inverse scaling (objective_scaling_direct = false): a penalty mode's NLP objective is
-// sigma J + P instead of J + (1/sigma) P, i.e. exactly sigma times it, at every point and sigma,
-// with the gradient scaled alike; modes without a penalty term ignore the setting. On the
-// two-variable MPCC both scalings reach the start's minimizer (1, 0).
 // The mode classes that the relaxation, the CLI header and these tests share.
 static_assert(fesd::is_elastic(MpccMode::ElasticIneq) &&
               fesd::is_elastic(MpccMode::ElasticTwoSided));
@@ -107,6 +103,10 @@ static_assert(fesd::penalizes(MpccMode::L1Penalty) && fesd::penalizes(MpccMode::
 static_assert(!fesd::penalizes(MpccMode::ScholtesIneq) && !fesd::penalizes(MpccMode::ScholtesEq) &&
               !fesd::penalizes(MpccMode::FischerBurmeister));
 
+// nosnoc's inverse scaling (objective_scaling_direct = false): a penalty mode's NLP objective is
+// sigma J + P instead of J + (1/sigma) P, i.e. exactly sigma times it, at every point and sigma,
+// with the gradient scaled alike; modes without a penalty term ignore the setting. On the
+// two-variable MPCC both scalings reach the start's minimizer (1, 0).
 TEST(ObjectiveScaling, InverseIsSigmaTimesDirect) {
   const std::vector<double> point{0.7, 0.3, 0.25};  // x, y, and s where a mode has it
   for (MpccMode mode : kAllModes) {
