@@ -162,11 +162,14 @@ def main():
     done = {(r["form"], r["value"]) for r in rows}
     writer = None
     if args.csv:
-        existing = args.resume and pathlib.Path(args.csv).exists()
+        # An empty file (a run stopped before its header reached the disk) starts afresh.
+        existing = args.resume and pathlib.Path(args.csv).exists() and \
+            pathlib.Path(args.csv).stat().st_size > 0
         csv_file = open(args.csv, "a" if existing else "w", newline="")
         writer = csv.DictWriter(csv_file, fieldnames=FIELDS)
         if not existing:
             writer.writeheader()
+            csv_file.flush()
     print("%-8s %4s %-24s %12s %9s %5s %6s %9s %8s" % ("form", key[:4], "status", "objective",
           "comp", "NLPs", "iter", "CPU s", "s/iter"), flush=True)
     with tempfile.TemporaryDirectory() as directory:
