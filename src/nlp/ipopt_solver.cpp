@@ -211,6 +211,12 @@ const KktModule& kkt_module() {
 /// NLP 4's first run ends Restoration_Failed after 563 iterations; again with 1e-2 it solves in
 /// 434 (with 1e-4: 883), where MUMPS took 382 at 4-5 times the cost per iteration.
 constexpr double kRetryPivtol = 1e-2;
+/// The second run of a warm-started NLP whose first failed: IPOPT's monotone mu strategy from
+/// this mu_init (the first run: the adaptive strategy, whose mu may climb far above the warm
+/// start's). Measured on examples/nosnoc/hopper_ocp.toml (docs/kkt-solver.md, "Retry, then
+/// fallback"): NLP 3 (sigma 0.1) ends Restoration_Failed with the adaptive mu climbing to 4e3
+/// within 10 iterations; monotone from 1e-4, NLPs 3-5 solve.
+constexpr double kWarmMuInit = 1e-4;
 constexpr double kRetryPivtolMax = 0.5;
 
 /// Whether a failed sparse_ldl solve is worth repeating with MUMPS: not when the outcome does not
@@ -266,6 +272,7 @@ void set_option(Ipopt::IpoptApplication& app, const std::string& name, const std
 struct IpoptSolver::Impl {
   Ipopt::SmartPtr<Ipopt::IpoptApplication> app;
   bool user_linear_solver = false;  // the caller chose IPOPT's linear_solver: never override it
+  bool user_mu_strategy = false;    // the caller chose IPOPT's mu_strategy: no monotone retry
   KktSolver kkt_solver = KktSolver::Auto;
   double tol = 0;    // the configured tol (NlpOptions::tol or [ipopt] extra)
   int max_iter = 0;  // the configured max_iter
@@ -287,6 +294,7 @@ IpoptSolver::IpoptSolver(const NlpOptions& o) : impl_(std::make_unique<Impl>()) 
   for (const auto& [name, value] : o.extra) {
     set_option(app, name, value);
     if (name == "linear_solver") impl_->user_linear_solver = true;
+    if (name == "mu_strategy") impl_->user_mu_strategy = true;
   }
   impl_->kkt_solver = o.kkt_solver;
   app.Options()->GetNumericValue("tol", impl_->tol, "");
@@ -335,8 +343,9 @@ NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_star
     if (mode >= 0 && !kkt_module().ok()) mode = -1;
     name = mode == FESD_KKT_DENSE ? "dense" : mode == FESD_KKT_SPARSE ? "sparse_ldl" : "mumps";
   }
-  // A failed sparse solve is repeated with MUMPS from the same start: keep it.
-  const bool may_retry = mode == FESD_KKT_SPARSE;
+  // A failed NLP is solved again from the same start (below): keep it.
+  const bool warm_retry = warm && !impl_->user_mu_strategy;
+  const bool may_retry = mode == FESD_KKT_SPARSE || warm_retry;
   const Iterate start_copy = may_retry ? start : Iterate{};
   const auto run = [&](int run_mode) {
     if (!impl_->user_linear_solver)
@@ -372,38 +381,59 @@ NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_star
   };
   auto [r, s] = run(mode);
   r.linear_solver = name;
-  // A failed sparse solve: once more with sparse_ldl and a stricter threshold pivoting
-  // (kRetryPivtol), then with MUMPS; each from the start of the first. `tried` names the runs
-  // that failed, for the result's linear_solver.
-  if (may_retry && !r.success && !r.eval_error && retry_with_mumps(s)) {
-    std::string tried = fmt::format("{} after {} iterations", r.status, r.iterations);
+  // A failed solve that another setting may cure (retry_with_mumps) is repeated from a copy of
+  // the same start, each run only if the one before failed too: a warm-started NLP with IPOPT's
+  // monotone mu strategy from kWarmMuInit (unless [ipopt] sets mu_strategy); a sparse_ldl one
+  // with a stricter threshold pivoting (kRetryPivtol), then with MUMPS. The result names the
+  // failed runs in linear_solver and counts the iterations and evaluation time of every run.
+  std::string tried = fmt::format("first run: {} after {} iterations", r.status, r.iterations);
+  const auto may_cure = [&] { return !r.success && !r.eval_error && retry_with_mumps(s); };
+  const auto again = [&](int run_mode, std::string_view what, const auto& set, const auto& reset) {
+    const NlpResult failed = r;
+    start = start_copy;
+    set();
+    std::tie(r, s) = run(run_mode);
+    reset();
+    r.eval_s += failed.eval_s;
+    r.iterations += failed.iterations;
+    const std::string solver = run_mode == mode ? name : "mumps";
+    r.linear_solver = fmt::format("{} ({}; {})", solver, what, tried);
+    if (!r.success)
+      tried += fmt::format("; {}: {} after {} iterations", what, r.status,
+                           r.iterations - failed.iterations);
+  };
+  if (warm_retry && may_cure()) {
+    double mu_init = 0.1;  // IPOPT's default, unless set in [ipopt]
+    app.Options()->GetNumericValue("mu_init", mu_init, "");
+    again(
+        mode, fmt::format("again with mu_strategy monotone from mu_init {:g}", kWarmMuInit),
+        [&] {
+          app.Options()->SetStringValue("mu_strategy", "monotone");
+          app.Options()->SetNumericValue("mu_init", kWarmMuInit);
+        },
+        [&] {
+          app.Options()->SetStringValue("mu_strategy", "adaptive");
+          app.Options()->SetNumericValue("mu_init", mu_init);
+        });
+  }
+  if (mode == FESD_KKT_SPARSE) {
     double pivtol = 1e-8, pivtolmax = 1e-4;  // IPOPT's defaults, unless set in [ipopt]
     app.Options()->GetNumericValue("ma27_pivtol", pivtol, "");
     app.Options()->GetNumericValue("ma27_pivtolmax", pivtolmax, "");
-    if (pivtol < kRetryPivtol) {
-      const NlpResult first = r;
-      start = start_copy;
-      app.Options()->SetNumericValue("ma27_pivtol", kRetryPivtol);
-      app.Options()->SetNumericValue("ma27_pivtolmax", std::max(pivtolmax, kRetryPivtolMax));
-      std::tie(r, s) = run(mode);
-      app.Options()->SetNumericValue("ma27_pivtol", pivtol);
-      app.Options()->SetNumericValue("ma27_pivtolmax", pivtolmax);
-      r.eval_s += first.eval_s;
-      r.iterations += first.iterations;
-      r.linear_solver = fmt::format("sparse_ldl (again with ma27_pivtol {:g}; first run: {})",
-                                    kRetryPivtol, tried);
-      if (!r.success)
-        tried += fmt::format("; with ma27_pivtol {:g}: {} after {} iterations", kRetryPivtol,
-                             r.status, r.iterations - first.iterations);
-    }
-    if (!r.success && !r.eval_error && retry_with_mumps(s)) {
-      const NlpResult failed = r;
-      start = start_copy;
-      r = run(-1).first;
-      r.eval_s += failed.eval_s;
-      r.iterations += failed.iterations;
-      r.linear_solver = fmt::format("mumps (sparse_ldl fallback: {})", tried);
-    }
+    if (pivtol < kRetryPivtol && may_cure())
+      again(
+          mode, fmt::format("again with ma27_pivtol {:g}", kRetryPivtol),
+          [&] {
+            app.Options()->SetNumericValue("ma27_pivtol", kRetryPivtol);
+            app.Options()->SetNumericValue("ma27_pivtolmax", std::max(pivtolmax, kRetryPivtolMax));
+          },
+          [&] {
+            app.Options()->SetNumericValue("ma27_pivtol", pivtol);
+            app.Options()->SetNumericValue("ma27_pivtolmax", pivtolmax);
+          });
+    if (may_cure())
+      again(
+          -1, "sparse_ldl fallback", [] {}, [] {});
   }
   r.total_s = seconds_since(t0);
   return r;
