@@ -240,7 +240,10 @@ struct NlpOptions {
   /// with sparse_ldl and ma27_pivtol 0.01 (unless [ipopt] sets a larger one), then, if that
   /// fails too, with MUMPS; HomotopyRow::linear_solver names the runs.
   KktSolver kkt_solver = KktSolver::Auto;
-  /// Extra IPOPT options as (name, value) strings, e.g. {"mu_strategy", "monotone"}.
+  /// Extra IPOPT options as (name, value) strings, e.g. {"mu_strategy", "monotone"}. A
+  /// warm-started NLP (every NLP of a homotopy after the first) that fails is solved again with
+  /// IPOPT's monotone mu strategy from mu_init 1e-4, unless `mu_strategy` is set here
+  /// (docs/kkt-solver.md, "Retry, then fallback").
   std::vector<std::pair<std::string, std::string>> extra;
 };
 
