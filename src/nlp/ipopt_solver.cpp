@@ -211,17 +211,20 @@ const KktModule& kkt_module() {
 /// NLP 4's first run ends Restoration_Failed after 563 iterations; again with 1e-2 it solves in
 /// 434 (with 1e-4: 883), where MUMPS took 382 at 4-5 times the cost per iteration.
 constexpr double kRetryPivtol = 1e-2;
+constexpr double kRetryPivtolMax = 0.5;
+
 /// The second run of a warm-started NLP whose first failed: IPOPT's monotone mu strategy from
 /// this mu_init (the first run: the adaptive strategy, whose mu may climb far above the warm
 /// start's). Measured on examples/nosnoc/hopper_ocp.toml (docs/kkt-solver.md, "Retry, then
 /// fallback"): NLP 3 (sigma 0.1) ends Restoration_Failed with the adaptive mu climbing to 4e3
 /// within 10 iterations; monotone from 1e-4, NLPs 3-5 solve.
 constexpr double kWarmMuInit = 1e-4;
-constexpr double kRetryPivtolMax = 0.5;
 
-/// Whether a failed sparse_ldl solve is worth repeating with MUMPS: not when the outcome does not
-/// depend on the linear solver (limits, the caller's stop, bad input, evaluation errors).
-bool retry_with_mumps(Ipopt::ApplicationReturnStatus s) {
+/// Whether a failed solve is worth repeating with another setting (IpoptSolver::solve: the
+/// monotone mu strategy, a stricter pivoting, MUMPS): not for the limits, the caller's stop and
+/// bad input, which no setting changes, nor for a detected infeasibility (the monotone run cured
+/// none of row 9's, docs/nosnoc-examples.md).
+bool worth_retrying(Ipopt::ApplicationReturnStatus s) {
   switch (s) {
     case Ipopt::Maximum_Iterations_Exceeded:
     case Ipopt::Maximum_CpuTime_Exceeded:
@@ -381,13 +384,13 @@ NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_star
   };
   auto [r, s] = run(mode);
   r.linear_solver = name;
-  // A failed solve that another setting may cure (retry_with_mumps) is repeated from a copy of
+  // A failed solve that another setting may cure (worth_retrying) is repeated from a copy of
   // the same start, each run only if the one before failed too: a warm-started NLP with IPOPT's
   // monotone mu strategy from kWarmMuInit (unless [ipopt] sets mu_strategy); a sparse_ldl one
   // with a stricter threshold pivoting (kRetryPivtol), then with MUMPS. The result names the
   // failed runs in linear_solver and counts the iterations and evaluation time of every run.
   std::string tried = fmt::format("first run: {} after {} iterations", r.status, r.iterations);
-  const auto may_cure = [&] { return !r.success && !r.eval_error && retry_with_mumps(s); };
+  const auto may_cure = [&] { return !r.success && !r.eval_error && worth_retrying(s); };
   const auto again = [&](int run_mode, std::string_view what, const auto& set, const auto& reset) {
     const NlpResult failed = r;
     start = start_copy;
