@@ -24,10 +24,12 @@ struct HomotopyRow {
   int nlp_iterations = 0;
   std::string nlp_status;  ///< IPOPT's return status, e.g. "Solve_Succeeded"
   double cpu_s = 0;
-  /// KKT solver IPOPT used: "dense" (LAPACK LDL', small NLPs), "sparse_ldl", "mumps", "sparse_ldl
-  /// (again with ma27_pivtol 0.01; first run: STATUS after N iterations)" or "mumps (sparse_ldl
-  /// fallback: the failed runs)" (NlpOptions::kkt_solver; nlp_iterations and cpu_s then count
-  /// every run, factor_s and factorizations the last one's).
+  /// KKT solver IPOPT used: "dense" (LAPACK LDL', small NLPs), "sparse_ldl", "mumps", or, for a
+  /// retried NLP, the last run's with what it changed and the failed runs, e.g. "sparse_ldl (again
+  /// with mu_strategy monotone from mu_init 0.0001; first run: STATUS after N iterations)" or
+  /// "mumps (sparse_ldl fallback; first run: ...; again with ma27_pivtol 0.01: ...)"
+  /// (NlpOptions::kkt_solver, NlpOptions::extra; nlp_iterations and cpu_s then count every run,
+  /// factor_s and factorizations the last one's).
   std::string linear_solver;
   /// Wall time of IPOPT's KKT factorizations, and their number with fesd's sparse LDL' (0 else).
   double factor_s = 0;

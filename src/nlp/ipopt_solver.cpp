@@ -406,6 +406,8 @@ NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_star
                            r.iterations - failed.iterations);
   };
   if (warm_retry && may_cure()) {
+    std::string mu_strategy;  // the first run's (fesd's adaptive)
+    app.Options()->GetStringValue("mu_strategy", mu_strategy, "");
     double mu_init = 0.1;  // IPOPT's default, unless set in [ipopt]
     app.Options()->GetNumericValue("mu_init", mu_init, "");
     again(
@@ -415,7 +417,7 @@ NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_star
           app.Options()->SetNumericValue("mu_init", kWarmMuInit);
         },
         [&] {
-          app.Options()->SetStringValue("mu_strategy", "adaptive");
+          app.Options()->SetStringValue("mu_strategy", mu_strategy);
           app.Options()->SetNumericValue("mu_init", mu_init);
         });
   }

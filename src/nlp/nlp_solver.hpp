@@ -21,11 +21,12 @@ struct NlpResult {
   bool success = false;     ///< converged (to tol or acceptable_tol)
   bool eval_error = false;  ///< stopped because evaluations kept failing (NaN/inf)
   std::string status;       ///< backend status name, e.g. "Solve_Succeeded"
-  /// KKT solver that produced the result: "dense" (LAPACK LDL'), "sparse_ldl", "sparse_ldl
-  /// (again with ma27_pivtol 0.01; first run: STATUS after N iterations)" (the first sparse_ldl run
-  /// failed, the second from the same start with stricter pivoting is the result), "mumps
-  /// (sparse_ldl fallback: ...)" (both sparse_ldl runs failed as listed, MUMPS solved again from
-  /// the same start), "mumps", or IPOPT's linear_solver when the caller set that.
+  /// KKT solver that produced the result: "dense" (LAPACK LDL'), "sparse_ldl", "mumps", IPOPT's
+  /// linear_solver when the caller set that, or, when runs from the same start failed before,
+  /// the last run's solver with what that run changed and the failed runs listed: "sparse_ldl
+  /// (again with mu_strategy monotone from mu_init 0.0001; first run: STATUS after N
+  /// iterations)", "sparse_ldl (again with ma27_pivtol 0.01; ...)", "mumps (sparse_ldl fallback;
+  /// ...)".
   std::string linear_solver;
   int iterations = 0;  ///< IPOPT iterations; after a retry or fallback those of every run
   double objective = 0, inf_pr = 0, inf_du = 0;
