@@ -542,23 +542,49 @@ FESD_KKT_INLINE double dot(const double* x, const double* y, int from, int to) {
   return s;
 }
 
-/// max |x(i)| over i = from .. ld (ld a multiple of 4), vectorized from the next multiple of 4.
-FESD_KKT_INLINE double abs_max(const double* x, int from, int ld) {
+/// max |x(i)| over i = from .. to - 1, vectorized between multiples of 4 (a front column's rows
+/// from `from` to its padded end, or any range). Maxima are exact, so the order of the comparisons
+/// does not change the value.
+FESD_KKT_INLINE double abs_max(const double* x, int from, int to) {
   using Bits = long long __attribute__((vector_size(32)));
   double m = 0.0;
   int i = from;
-  for (; i < ld && (i & 3) != 0; ++i) m = std::max(m, std::abs(x[i]));
-  if (i < ld) {
-    constexpr long long kMagnitude = 0x7fffffffffffffffLL;  // all bits but the sign
+  for (; i < to && (i & 3) != 0; ++i) m = std::max(m, std::abs(x[i]));
+  if (i + 4 <= to) {
+    constexpr long long kMagnitude = 0x7fffffffffffffffLL;
     const Bits magnitude = {kMagnitude, kMagnitude, kMagnitude, kMagnitude};
     Vec4 acc = {};
-    for (; i < ld; i += 4) {
+    for (; i + 4 <= to; i += 4) {
       const Vec4 v = reinterpret_cast<Vec4>(reinterpret_cast<Bits>(load4(x + i)) & magnitude);
       acc = acc > v ? acc : v;
     }
     m = std::max({m, acc[0], acc[1], acc[2], acc[3]});
   }
+  for (; i < to; ++i) m = std::max(m, std::abs(x[i]));
   return m;
+}
+
+/// Row p of a front left of its diagonal, columns k .. p - 1 (strided), read once for the pivot
+/// search: the largest |a_pi| and the first i with it (-1 if all are zero), and the largest of the
+/// others (the 2x2 test's maximum without its partner q = that i).
+struct RowMax {
+  double max1 = 0.0, max2 = 0.0;
+  int arg1 = -1;
+};
+FESD_KKT_INLINE RowMax row_max(const double* f, std::size_t lds, int p, int k) {
+  RowMax r;
+  const double* a = f + static_cast<std::size_t>(k) * lds + p;
+  for (int i = k; i < p; ++i, a += lds) {
+    const double v = std::abs(*a);
+    if (v > r.max1) {
+      r.max2 = r.max1;
+      r.max1 = v;
+      r.arg1 = i;
+    } else {
+      r.max2 = std::max(r.max2, v);
+    }
+  }
+  return r;
 }
 
 /// w(i) = c(i), c(i) = c(i) / d for i = from .. ld (the padding rows stay zero), in vector
@@ -682,9 +708,12 @@ FESD_KKT_KERNEL PivotResult partial_ldlt(int nf, int nfs, double* storage, int* 
       twos = 0;
     }
     for (int p = k; p < nfs && pivot_p < 0; ++p) {
-      // The column maximum first (vectorized); the 2x2 partner only if the 1x1 test fails.
-      double cmax = abs_max(F.col(p), p + 1, ld);
-      for (int i = k; i < p; ++i) cmax = std::max(cmax, std::abs(F.at(p, i)));
+      // The column maximum first (column p vectorized, row p in one strided pass that also
+      // serves the 2x2 search); the 2x2 partner only if the 1x1 test fails. Every maximum is
+      // exact, so the pivots are those of one scalar loop over each row and column.
+      const RowMax row = row_max(storage, lds, p, k);
+      const double colmax = abs_max(F.col(p), p + 1, ld);
+      const double cmax = std::max(colmax, row.max1);
       const double app = F.at(p, p);
       if (std::abs(app) > tiny && std::abs(app) >= u * cmax) {
         pivot_p = p;
@@ -701,33 +730,35 @@ FESD_KKT_KERNEL PivotResult partial_ldlt(int nf, int nfs, double* storage, int* 
         zero_pivot = true;
         break;
       }
-      double qmax = 0.0;
-      int q = -1;
-      for (int i = k; i < p; ++i) {
-        const double v = std::abs(F.at(p, i));
-        if (v > qmax) {
-          qmax = v;
-          q = i;
-        }
-      }
-      for (int i = p + 1; i < nfs; ++i) {
-        const double v = std::abs(F.at(i, p));
-        if (v > qmax) {
-          qmax = v;
-          q = i;
-        }
+      // The partner q: the largest |a_pi| over the other fully summed rows, the first such i
+      // (row p's if it holds the largest, else the first in column p that does).
+      double qmax = row.max1;
+      int q = row.arg1;
+      const double* colp = F.col(p);
+      if (const double m = abs_max(colp, p + 1, nfs); m > qmax) {
+        qmax = m;
+        q = p + 1;
+        while (std::abs(colp[q]) != m) ++q;
       }
       if (q < 0 || qmax <= tiny) continue;
       // 2x2 candidate (p, q): column maxima outside the block, then |D^-1| [cp; cq] <= 1/u.
       const double aqq = F.at(q, q), apq = F.sym(p, q);
       const double det = app * aqq - apq * apq;
       if (std::abs(det) <= tiny * std::max({std::abs(app), std::abs(aqq), std::abs(apq)})) continue;
-      double cp = 0.0, cq = 0.0;
-      for (int i = k; i < nf; ++i) {
-        if (i == p || i == q) continue;
-        cp = std::max(cp, std::abs(F.sym(i, p)));
-        cq = std::max(cq, std::abs(F.sym(i, q)));
-      }
+      // cp over rows k .. nf - 1 but p, q: row p without q (row.max2 if q is in it), column p
+      // (without q if q is below p; the padding rows are zero).
+      const double cp =
+          q < p ? std::max(row.max2, colmax)
+                : std::max({row.max1, abs_max(colp, p + 1, q), abs_max(colp, q + 1, ld)});
+      // cq likewise: row q (strided, without p), then column q below q (without p).
+      double cq = 0.0;
+      for (int i = k; i < q; ++i)
+        if (i != p) cq = std::max(cq, std::abs(F.at(q, i)));
+      const double* colq = F.col(q);
+      if (p > q)
+        cq = std::max({cq, abs_max(colq, q + 1, p), abs_max(colq, p + 1, ld)});
+      else
+        cq = std::max(cq, abs_max(colq, q + 1, ld));
       const double bound = std::abs(det) / u;
       if (std::abs(aqq) * cp + std::abs(apq) * cq <= bound &&
           std::abs(apq) * cp + std::abs(app) * cq <= bound) {
