@@ -10,8 +10,9 @@ Each point writes its variant with scripts/hopper_variant.py into a temporary di
 `fesd solve VARIANT --json OUT` and reads status, objective, IPOPT iterations and the CPU time of
 the NLPs (the sum over the homotopy, as nosnoc_py's cpu_time_nlp). It prints one row per point;
 --csv writes them, each as soon as its point has finished (a point takes 10-40 min of CPU time),
-and --resume keeps the rows already in that file and runs only the missing points, so a sweep
-can be run in pieces; --plot draws the scripts' two figures (CPU time, and CPU time per IPOPT
+and --resume keeps the finished rows of that file and runs the other points (missing ones, and
+those that ended by --timeout or without a result: their rows are dropped), so a sweep can be
+run in pieces; --plot draws the scripts' two figures (CPU time, and CPU time per IPOPT
 iteration, over n_s or N, step form against Stewart's). Nothing is written unless asked.
 
   python3 scripts/hopper_sweep.py ns --points 2,3 --csv /tmp/ns.csv --plot /tmp/ns.png
@@ -20,6 +21,7 @@ iteration, over n_s or N, step form against Stewart's). Nothing is written unles
 import argparse
 import csv
 import json
+import os
 import pathlib
 import subprocess
 import sys
@@ -134,7 +136,7 @@ def main():
     a.add_argument("--timeout", type=float, default=3600, help="seconds per point")
     a.add_argument("--csv", help="write the rows as CSV, each when its point has finished")
     a.add_argument("--resume", action="store_true",
-                   help="keep the rows of --csv's file and run only the points not in it")
+                   help="keep the finished rows of --csv's file and run only the other points")
     a.add_argument("--plot", help="draw the scripts' two figures (PNG/SVG)")
     args = a.parse_args()
     key, points, flags, no_guess = EXPERIMENTS[args.experiment]
@@ -158,18 +160,23 @@ def main():
     if args.resume:
         if not args.csv:
             a.error("--resume needs --csv")
-        rows = read_rows(args.csv, key)
+        # Points that ended without a result (timeout, a non-zero exit without JSON) are run
+        # again, and their rows dropped from the file.
+        rows = [r for r in read_rows(args.csv, key) if "objective" in r]
     done = {(r["form"], r["value"]) for r in rows}
     writer = None
     if args.csv:
-        # An empty file (a run stopped before its header reached the disk) starts afresh.
-        existing = args.resume and pathlib.Path(args.csv).exists() and \
-            pathlib.Path(args.csv).stat().st_size > 0
-        csv_file = open(args.csv, "a" if existing else "w", newline="")
+        # The kept rows go to a new file that then replaces the old one (a run stopped here
+        # loses nothing); the new points are appended to it as they finish.
+        tmp = pathlib.Path(args.csv + ".tmp")
+        with open(tmp, "w", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=FIELDS)
+            w.writeheader()
+            for r in rows:
+                w.writerow({k: r[k] for k in FIELDS if k in r})
+        os.replace(tmp, args.csv)
+        csv_file = open(args.csv, "a", newline="")
         writer = csv.DictWriter(csv_file, fieldnames=FIELDS)
-        if not existing:
-            writer.writeheader()
-            csv_file.flush()
     print("%-8s %4s %-24s %12s %9s %5s %6s %9s %8s" % ("form", key[:4], "status", "objective",
           "comp", "NLPs", "iter", "CPU s", "s/iter"), flush=True)
     with tempfile.TemporaryDirectory() as directory:
