@@ -551,7 +551,7 @@ FESD_KKT_INLINE double abs_max(const double* x, int from, int to) {
   int i = from;
   for (; i < to && (i & 3) != 0; ++i) m = std::max(m, std::abs(x[i]));
   if (i + 4 <= to) {
-    constexpr long long kMagnitude = 0x7fffffffffffffffLL;
+    constexpr long long kMagnitude = 0x7fffffffffffffffLL;  // all bits but the sign
     const Bits magnitude = {kMagnitude, kMagnitude, kMagnitude, kMagnitude};
     Vec4 acc = {};
     for (; i + 4 <= to; i += 4) {
