@@ -53,6 +53,7 @@
 #include "fesd/status.hpp"
 #include "fesd/tableau.hpp"
 #include "io/describe.hpp"
+#include "nlp/nlp_solver.hpp"
 
 #ifndef FESD_VERSION
 #define FESD_VERSION "0.1.0"
@@ -397,6 +398,7 @@ void print_solver_header(const std::string& n_fe, const fesd::DiscretizationOpti
   for (const auto& [key, value] : nlp.extra) out::print(", {} = {}", key, value);
   out::print("\n");
   for (const std::string& w : fesd::warnings(h)) out::print("  warning     {}\n", w);
+  for (const std::string& w : fesd::nlp::warnings(nlp)) out::print("  warning     {}\n", w);
 }
 
 void print_header(const fesd::SimulationProblem& problem) {

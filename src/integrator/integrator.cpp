@@ -129,6 +129,7 @@ class Integrator {
         x_(x0) {
     res_.summary.warnings = warnings(options.homotopy);
     settings_cannot_reach_ = !res_.summary.warnings.empty();
+    for (auto& w : nlp::warnings(options.nlp)) res_.summary.warnings.push_back(std::move(w));
     // Initial guess of the first step: the LP at x0 (then the last stage of the step before).
     guess_ = dcs::solve_start(model_, d_.dcs_mode, x0, p_);
     // IntegratorOptions::theta_guess replaces the LP's theta; lambda and mu stay the LP's (on a

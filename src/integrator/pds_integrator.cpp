@@ -157,6 +157,7 @@ IntegratorResult integrate(const Pds& model, const Eigen::VectorXd& x0, double T
   IntegratorResult res;
   res.summary.warnings = warnings(options.homotopy);
   for (auto& w : licq_warnings(model, x0, p)) res.summary.warnings.push_back(std::move(w));
+  for (auto& w : nlp::warnings(options.nlp)) res.summary.warnings.push_back(std::move(w));
 
   // ---- the step problem ----
   mpcc::Problem mpcc;

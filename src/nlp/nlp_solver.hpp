@@ -54,4 +54,12 @@ class NlpSolver {
 /// fesd::InvalidOption if the backend rejects an option (the message names it).
 std::unique_ptr<NlpSolver> make_solver(const NlpOptions& options);
 
+/// Valid settings the backend cannot honour as well as asked, one sentence each: kkt_solver =
+/// auto when fesd's KKT module (libfesd_kkt.so, next to libfesd.so) cannot be loaded, so that
+/// every KKT system goes to MUMPS (the same iterates up to round-off, 4-5x the time per IPOPT
+/// iteration on the hopper OCP). The front ends add them to Summary::warnings; the CLI prints them
+/// before a run. An explicit kkt_solver = sparse_ldl or dense without the module is an error
+/// (make_solver throws).
+std::vector<std::string> warnings(const NlpOptions& options);
+
 }  // namespace fesd::nlp

@@ -837,4 +837,34 @@ TEST(Cli, SensitivitiesInSummaryAndJson) {
   EXPECT_FALSE(contains(plain.out, "sensitivities")) << plain.out;
 }
 
+// REAL SOLVE (Example 3(a), 10 steps, well under a second, twice).
+TEST(CliRobust, MissingKktModuleWarnsUnderAutoAndIsAnErrorWhenAsked) {
+  // A broken install: libfesd.so without libfesd_kkt.so next to it. fesd used to run every KKT
+  // system with MUMPS without a word (4-5x the time per IPOPT iteration on the hopper OCP).
+  TempDir dir;
+  const fs::path build_dir = fs::path(FESD_KKT_MODULE).parent_path();
+  fs::copy_file(FESD_CLI, dir.file("fesd"));
+  fs::copy_file(fs::canonical(build_dir / "libfesd.so.0"), dir.file("libfesd.so.0"));
+  ASSERT_FALSE(fs::exists(dir.file("libfesd_kkt.so")));
+  const auto run = [&](const std::string& kkt_solver) {
+    const int code = run_shell(
+        "LD_LIBRARY_PATH=" + shell_quote(dir.file("")) + " " + shell_quote(dir.file("fesd")) +
+        " simulate " + shell_quote(kCrossing) + " --step_solver homotopy --kkt_solver " +
+        kkt_solver + " >" + shell_quote(dir.file("out")) + " 2>" + shell_quote(dir.file("err")));
+    return CliRun{code, read_file(dir.file("out")), read_file(dir.file("err"))};
+  };
+  const CliRun asked = run("sparse_ldl");
+  EXPECT_EQ(asked.code, 2) << asked.out << asked.err;
+  EXPECT_TRUE(contains(asked.err, "kkt_solver = sparse_ldl: fesd's KKT module is not available"))
+      << asked.err;
+  EXPECT_TRUE(contains(asked.err, "libfesd_kkt.so")) << asked.err;
+  EXPECT_EQ(asked.err_lines(), 1) << asked.err;
+
+  const CliRun fallback = run("auto");
+  EXPECT_EQ(fallback.code, 0) << fallback.out << fallback.err;
+  EXPECT_TRUE(contains(fallback.out, "kkt_solver = auto: fesd's KKT module is not available"))
+      << fallback.out;
+  EXPECT_TRUE(contains(fallback.out, "with MUMPS")) << fallback.out;
+}
+
 }  // namespace
