@@ -242,8 +242,9 @@ struct NlpOptions {
   KktSolver kkt_solver = KktSolver::Auto;
   /// Extra IPOPT options as (name, value) strings, e.g. {"mu_strategy", "monotone"}. A
   /// warm-started NLP (every NLP of a homotopy after the first) that fails is solved again with
-  /// IPOPT's monotone mu strategy from mu_init 1e-4, unless `mu_strategy` is set here
-  /// (docs/kkt-solver.md, "Retry, then fallback").
+  /// IPOPT's monotone mu strategy from mu_init 1e-4, unless `mu_strategy` is set here; once that
+  /// cured an NLP, the homotopy's later warm-started NLPs run monotone first, adaptive as the
+  /// retry (docs/kkt-solver.md, "Retry, then fallback").
   std::vector<std::pair<std::string, std::string>> extra;
 };
 

@@ -26,7 +26,9 @@ struct HomotopyRow {
   double cpu_s = 0;
   /// KKT solver IPOPT used: "dense" (LAPACK LDL', small NLPs), "sparse_ldl", "mumps", or, for a
   /// retried NLP, the last run's with what it changed and the failed runs, e.g. "sparse_ldl (again
-  /// with mu_strategy monotone from mu_init 0.0001; first run: STATUS after N iterations)" or
+  /// with mu_strategy monotone from mu_init 0.0001; first run: STATUS after N iterations)", a
+  /// warm start that ran monotone first because an NLP before needed it ("sparse_ldl (mu_strategy
+  /// monotone from mu_init 0.0001, as an NLP before needed)"), or
   /// "mumps (sparse_ldl fallback; first run: ...; again with ma27_pivtol 0.01: ...)"
   /// (NlpOptions::kkt_solver, NlpOptions::extra; nlp_iterations and cpu_s then count every run,
   /// factor_s and factorizations the last one's).

@@ -285,6 +285,9 @@ struct IpoptSolver::Impl {
   Ipopt::SmartPtr<Ipopt::IpoptApplication> app;
   bool user_linear_solver = false;  // the caller chose IPOPT's linear_solver: never override it
   bool user_mu_strategy = false;    // the caller chose IPOPT's mu_strategy: no monotone retry
+  // A warm-started NLP since the last cold start failed with the adaptive mu strategy and solved
+  // on the monotone retry: the next warm-started NLPs run monotone first (kWarmMuInit).
+  bool warm_monotone = false;
   KktSolver kkt_solver = KktSolver::Auto;
   double tol = 0;    // the configured tol (NlpOptions::tol or [ipopt] extra)
   int max_iter = 0;  // the configured max_iter
@@ -347,6 +350,7 @@ NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_star
       "max_iter", max_iter > 0 ? std::min(max_iter, impl_->max_iter) : impl_->max_iter);
   const bool warm = warm_start && start.has_duals();
   app.Options()->SetStringValue("warm_start_init_point", warm ? "yes" : "no");
+  if (!warm) impl_->warm_monotone = false;  // a new homotopy (or a cold restart)
   // Which KKT solver: IPOPT's linear_solver if the caller set it, else kkt_solver's choice, the
   // dense and sparse LDL' through fesd's module as IPOPT's "ma27".
   int mode = -1;  // the module's mode, -1: not the module
@@ -409,14 +413,36 @@ NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_star
     r.eval_s = tnlp->eval_s();
     return std::pair{r, s};
   };
+  // The mu strategy of a warm-started NLP: fesd's adaptive one (or [ipopt]'s mu_init with it), or
+  // IPOPT's monotone one from kWarmMuInit, first once an NLP of this homotopy needed it.
+  std::string mu_strategy;
+  app.Options()->GetStringValue("mu_strategy", mu_strategy, "");
+  double mu_init = 0.1;  // IPOPT's default, unless set in [ipopt]
+  app.Options()->GetNumericValue("mu_init", mu_init, "");
+  const auto set_monotone = [&] {
+    app.Options()->SetStringValue("mu_strategy", "monotone");
+    app.Options()->SetNumericValue("mu_init", kWarmMuInit);
+  };
+  const auto reset_mu = [&] {
+    app.Options()->SetStringValue("mu_strategy", mu_strategy);
+    app.Options()->SetNumericValue("mu_init", mu_init);
+  };
+  const bool monotone_first = warm_retry && impl_->warm_monotone;
+  if (monotone_first) set_monotone();
   auto [r, s] = run(mode);
-  r.linear_solver = name;
+  if (monotone_first) reset_mu();
+  const std::string monotone = fmt::format("mu_strategy monotone from mu_init {:g}", kWarmMuInit);
+  r.linear_solver =
+      monotone_first ? fmt::format("{} ({}, as an NLP before needed)", name, monotone) : name;
   // A failed solve that another setting may cure (worth_retrying) is repeated from a copy of
-  // the same start, each run only if the one before failed too: a warm-started NLP with IPOPT's
-  // monotone mu strategy from kWarmMuInit (unless [ipopt] sets mu_strategy); a sparse_ldl one
-  // with a stricter threshold pivoting (kRetryPivtol), then with MUMPS. The result names the
-  // failed runs in linear_solver and counts the iterations and evaluation time of every run.
-  std::string tried = fmt::format("first run: {} after {} iterations", r.status, r.iterations);
+  // the same start, each run only if the one before failed too: a warm-started NLP with the other
+  // mu strategy (IPOPT's monotone one from kWarmMuInit, or after a monotone first run the
+  // adaptive one; not if [ipopt] sets mu_strategy); a sparse_ldl one with a stricter threshold
+  // pivoting (kRetryPivtol), then with MUMPS. The result names the failed runs in linear_solver
+  // and counts the iterations and evaluation time of every run.
+  std::string tried =
+      fmt::format("first run{}: {} after {} iterations",
+                  monotone_first ? " (" + monotone + ")" : std::string(), r.status, r.iterations);
   const auto may_cure = [&] { return !r.success && !r.eval_error && worth_retrying(s); };
   const auto again = [&](int run_mode, std::string_view what, const auto& set, const auto& reset) {
     const NlpResult failed = r;
@@ -433,20 +459,14 @@ NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_star
                            r.iterations - failed.iterations);
   };
   if (warm_retry && may_cure()) {
-    std::string mu_strategy;  // the first run's (fesd's adaptive)
-    app.Options()->GetStringValue("mu_strategy", mu_strategy, "");
-    double mu_init = 0.1;  // IPOPT's default, unless set in [ipopt]
-    app.Options()->GetNumericValue("mu_init", mu_init, "");
-    again(
-        mode, fmt::format("again with mu_strategy monotone from mu_init {:g}", kWarmMuInit),
-        [&] {
-          app.Options()->SetStringValue("mu_strategy", "monotone");
-          app.Options()->SetNumericValue("mu_init", kWarmMuInit);
-        },
-        [&] {
-          app.Options()->SetStringValue("mu_strategy", mu_strategy);
-          app.Options()->SetNumericValue("mu_init", mu_init);
-        });
+    if (monotone_first) {
+      again(
+          mode, "again with mu_strategy " + mu_strategy, [] {}, [] {});
+      if (r.success) impl_->warm_monotone = false;  // this homotopy's NLPs no longer need it
+    } else {
+      again(mode, "again with " + monotone, set_monotone, reset_mu);
+      if (r.success) impl_->warm_monotone = true;
+    }
   }
   if (mode == FESD_KKT_SPARSE) {
     double pivtol = 1e-8, pivtolmax = 1e-4;  // IPOPT's defaults, unless set in [ipopt]

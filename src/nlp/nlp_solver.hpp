@@ -26,7 +26,8 @@ struct NlpResult {
   /// the last run's solver with what that run changed and the failed runs listed: "sparse_ldl
   /// (again with mu_strategy monotone from mu_init 0.0001; first run: STATUS after N
   /// iterations)", "sparse_ldl (again with ma27_pivtol 0.01; ...)", "mumps (sparse_ldl fallback;
-  /// ...)".
+  /// ...)"; a warm start run monotone first because an NLP before needed it: "sparse_ldl
+  /// (mu_strategy monotone from mu_init 0.0001, as an NLP before needed)".
   std::string linear_solver;
   int iterations = 0;  ///< IPOPT iterations; after a retry or fallback those of every run
   double objective = 0, inf_pr = 0, inf_du = 0;

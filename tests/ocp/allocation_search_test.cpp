@@ -8,6 +8,7 @@
 // all N_FE - 1 allocations in bench/ocp_robustness ("discrete minimizer (scan over the ...
 // allocations)"), with default options otherwise.
 #include <cmath>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -93,6 +94,35 @@ INSTANTIATE_TEST_SUITE_P(
                                      kRadau10X0, kRadau10V},
                       AllocationCase{RkScheme::RadauIIA, 1, 10, OcpInitialization::Simulation, 2.7,
                                      kRadau10X0, kRadau10V}));
+
+// A warm-started NLP that fails with IPOPT's adaptive mu strategy and solves on the monotone
+// retry makes the homotopy's later warm-started NLPs run monotone first (IpoptSolver::solve). In
+// this case (the allocation search's re-solves) one NLP ends Search_Direction_Becomes_Too_Small
+// with the adaptive strategy after 14 iterations and solves monotone in 12; the four NLPs after it
+// then solve monotone at once (9, 6, 8, 7 iterations) instead of adaptive first.
+TEST(AllocationSearchWarmStarts, MonotoneFirstOnceAnNlpNeededIt) {
+  const AllocationCase c{RkScheme::RadauIIA, 1,        25, OcpInitialization::Constant, -0.9,
+                         kRadau25X0,         kRadau25V};
+  const fesd::OcpResult r = fesd::solve(sensitivity_ocp(c.guess), defaults_with(c));
+  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+  EXPECT_NEAR(r.objective, c.objective, 1e-8);
+  const std::string retry = "again with mu_strategy monotone from mu_init 0.0001";
+  const std::string first =
+      "sparse_ldl (mu_strategy monotone from mu_init 0.0001, as an NLP before";
+  std::size_t cured = r.homotopy.size();
+  for (std::size_t k = 0; k < r.homotopy.size(); ++k)
+    if (r.homotopy[k].linear_solver.find(retry) != std::string::npos) {
+      cured = k;
+      break;
+    }
+  ASSERT_LT(cured + 1, r.homotopy.size()) << "no NLP needed the monotone retry";
+  EXPECT_EQ(r.homotopy[cured].nlp_status, "Solve_Succeeded");
+  for (std::size_t k = cured + 1; k < r.homotopy.size(); ++k) {
+    EXPECT_EQ(r.homotopy[k].linear_solver.rfind(first, 0), 0u)
+        << "NLP " << k << ": " << r.homotopy[k].linear_solver;
+    EXPECT_EQ(r.homotopy[k].nlp_status, "Solve_Succeeded") << "NLP " << k;
+  }
+}
 
 // Where the quadrature is exact (Gauss-Legendre n_s = 2 on (56)) the allocation does not change
 // the cost: the re-gridded points predict no gain and the search solves nothing.
