@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <tuple>
 
 #include <fmt/format.h>
@@ -279,6 +280,12 @@ void set_option(Ipopt::IpoptApplication& app, const std::string& name, const std
     throw InvalidOption(fmt::format("ipopt.{} = '{}': IPOPT rejects this value", name, value));
 }
 
+/// Whether the caller passes IPOPT option `name` itself ([ipopt] / NlpOptions::extra).
+bool user_sets(const NlpOptions& o, std::string_view name) {
+  return std::any_of(o.extra.begin(), o.extra.end(),
+                     [&](const auto& kv) { return kv.first == name; });
+}
+
 }  // namespace
 
 struct IpoptSolver::Impl {
@@ -306,11 +313,9 @@ IpoptSolver::IpoptSolver(const NlpOptions& o) : impl_(std::make_unique<Impl>()) 
   // IPOPT relaxes every bound by 1e-8 by default, so "product <= sigma" would only hold up to
   // 1e-8: complementarity could never get below that. Bounds are kept exact.
   app.Options()->SetNumericValue("bound_relax_factor", 0.0);
-  for (const auto& [name, value] : o.extra) {
-    set_option(app, name, value);
-    if (name == "linear_solver") impl_->user_linear_solver = true;
-    if (name == "mu_strategy") impl_->user_mu_strategy = true;
-  }
+  for (const auto& [name, value] : o.extra) set_option(app, name, value);
+  impl_->user_linear_solver = user_sets(o, "linear_solver");
+  impl_->user_mu_strategy = user_sets(o, "mu_strategy");
   impl_->kkt_solver = o.kkt_solver;
   const bool needs_module =
       o.kkt_solver == KktSolver::SparseLdl || o.kkt_solver == KktSolver::Dense;
@@ -331,9 +336,8 @@ IpoptSolver::IpoptSolver(const NlpOptions& o) : impl_(std::make_unique<Impl>()) 
 IpoptSolver::~IpoptSolver() = default;
 
 std::vector<std::string> warnings(const NlpOptions& o) {
-  const bool user_linear_solver = std::any_of(
-      o.extra.begin(), o.extra.end(), [](const auto& kv) { return kv.first == "linear_solver"; });
-  if (user_linear_solver || o.kkt_solver != KktSolver::Auto || kkt_module().ok()) return {};
+  if (user_sets(o, "linear_solver") || o.kkt_solver != KktSolver::Auto || kkt_module().ok())
+    return {};
   return {fmt::format(
       "kkt_solver = auto: fesd's KKT module is not available ({}), so IPOPT solves every KKT "
       "system with MUMPS (4-5x the time per iteration on large OCPs); libfesd_kkt.so belongs next "
