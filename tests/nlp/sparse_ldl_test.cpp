@@ -8,6 +8,7 @@
 #include <cmath>
 #include <random>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -366,7 +367,7 @@ ReorderRun reorder_run(int nx, int m, int zero_every) {
   before = kkt_stats().reorderings;
   EXPECT_EQ(solver.factor(perturbed.val), 0);
   out.reorders_second = kkt_stats().reorderings - before;
-  out.entries_second = kkt_stats().last_factor_entries;
+  out.entries_second = kkt_stats().last_static_entries;
   const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(perturbed.n, -1, 2);
   out.berr = sparse_backward_error(perturbed, solver.solve(b), b);
   before = kkt_stats().reorderings;
@@ -374,7 +375,7 @@ ReorderRun reorder_run(int nx, int m, int zero_every) {
   EXPECT_GE(solver.factor(unperturbed.val), 0);
   out.reorders_third = kkt_stats().reorderings - before;
   EXPECT_EQ(solver.factor(perturbed.val), 0);
-  out.entries_fourth = kkt_stats().last_factor_entries;
+  out.entries_fourth = kkt_stats().last_static_entries;
   EXPECT_LT(sparse_backward_error(perturbed, solver.solve(b), b), 1e-14);
   out.undone = kkt_stats().reorderings_undone - start.reorderings_undone;
   Ma27 fresh(perturbed, FESD_KKT_SPARSE);
@@ -388,7 +389,8 @@ TEST(SparseLdl, OrderingComputedAgainWhenFewerDiagonalsAreZeroUndoneIfNotSmaller
   // Random KKT matrices: the ordering of the perturbed matrix has about the static factor size of
   // the one matched on the unperturbed matrix (random coupling fills either way), so the
   // re-ordering is undone before anything is factorized with it: every factor of the structure
-  // has the entries of the old ordering.
+  // has the static fronts of the old ordering (entries without delayed pivots: those depend on the
+  // scaling, which a factorization may have started afresh, kRescaleGrowth).
   for (int every : {2, 3}) {
     const ReorderRun r = reorder_run(3000, 2200, every);  // 5200 rows
     EXPECT_EQ(r.reorders_first, 0) << every;
@@ -423,6 +425,69 @@ TEST(SparseLdl, HopperOcpKeepsTheOrderingOfItsPerturbedMatrices) {
   EXPECT_EQ(r.homotopy[1].linear_solver, "sparse_ldl");
   EXPECT_GE(after.reorderings - before.reorderings, 1);
   EXPECT_EQ(after.reorderings_undone - before.reorderings_undone, 0);
+}
+
+// The factorization's own memory (front buffers, contribution blocks) follows the largest
+// factorization, not the history of them. The contribution blocks not in place were kept in a pool
+// of vectors, each grown to the largest block it had ever held: on the hopper sweep's n_s = 5
+// point the pool reached 619 MB for factors of 6e6 entries (48 MB), then 2.1 GB after one
+// delayed-pivot cascade, and the out-of-memory killer ended the run at 16.9 GB
+// (docs/kkt-solver.md, "Memory"). Now they are one stack. Measured here (3 NLPs of 20 iterations):
+// 8.1 MB of scratch for a factor of 10.9 MB (the stack 5.2 MB, the largest factorization's peak);
+// with the pool 28.9 MB.
+TEST(SparseLdl, ScratchMemoryIsAFractionOfTheFactorOnTheHopperOcp) {
+  ASSERT_NE(module().stats, nullptr);
+  fesd::OcpProblem p =
+      fesd::load_ocp_problem(std::string(FESD_SOURCE_DIR) + "/examples/nosnoc/hopper_ocp.toml");
+  p.options.homotopy.max_homotopy_steps = 3;
+  p.options.homotopy.homotopy_retries = 0;
+  p.options.nlp.max_iter = 20;
+  p.options.nlp.kkt_solver = fesd::KktSolver::SparseLdl;
+  FesdKktStats after{};
+  // A thread of its own: the scratch memory is per thread, this one starts with none.
+  std::thread([&] {
+    const fesd::OcpResult r = fesd::solve(p.ocp, p.options);
+    EXPECT_EQ(r.homotopy.size(), 3U) << r.message;
+    after = kkt_stats();
+  }).join();
+  ASSERT_GT(after.factorizations, 40);
+  const double factor_bytes = 8.0 * static_cast<double>(after.last_factor_entries);
+  EXPECT_GT(after.scratch_bytes, 0);
+  EXPECT_LT(static_cast<double>(after.scratch_bytes), 1.5 * factor_bytes)
+      << after.scratch_bytes << " bytes of scratch for a factor of " << factor_bytes << " bytes";
+}
+
+// From 1000 rows on, a factorization starts from the previous one's scaling and does one Ruiz
+// sweep. When the diagonal has moved by orders of magnitude (IPOPT's barrier terms), that sweep
+// leaves the matrix far from equilibrated, pivots fail the threshold test and are delayed; a
+// factor with more than 1.25x the static fronts' entries is done again with the scaling from the
+// identity (sparse_ldl.cpp, kRescaleGrowth; docs/kkt-solver.md, "Delayed-pivot cascades").
+TEST(SparseLdl, DriftedWarmScalingIsStartedAfresh) {
+  ASSERT_NE(module().stats, nullptr);
+  std::mt19937 rng(31);
+  const int nx = 1500, m = 1000;
+  const Triplets a = random_kkt(rng, nx, m, 0.0);
+  // b = D a D, the same matrix in other units, D_i = 2^60 or 2^-60 at random: one sweep from a's
+  // scaling takes b's only half-way (in log scale) to equilibrium, and one from b's takes a's
+  // half-way back. Measured: a's factor has 232406 entries (static fronts 222228); started from
+  // b's scaling without the fresh start, it had more than 1.25x (k = 2, 4: done again).
+  Triplets b = a;
+  std::vector<double> d(static_cast<std::size_t>(a.n));
+  for (double& di : d) di = (rng() % 2 == 0) ? std::ldexp(1.0, 60) : std::ldexp(1.0, -60);
+  for (int e = 0; e < b.nz(); ++e) b.val[e] *= d[b.irn[e] - 1] * d[b.icn[e] - 1];
+  Ma27 solver(a, FESD_KKT_SPARSE);
+  const Eigen::VectorXd rhs = Eigen::VectorXd::LinSpaced(a.n, -1, 2);
+  const long long before = kkt_stats().rescalings;
+  for (int k = 0; k < 6; ++k) {
+    const Triplets& t = k % 2 == 0 ? a : b;
+    ASSERT_GE(solver.factor(t.val), 0) << k;
+    const FesdKktStats st = kkt_stats();
+    EXPECT_LE(static_cast<double>(st.last_factor_entries),
+              1.25 * static_cast<double>(st.last_static_entries))
+        << k;
+    EXPECT_LT(sparse_backward_error(t, solver.solve(rhs), rhs), 1e-14) << k;
+  }
+  EXPECT_GE(kkt_stats().rescalings - before, 1);
 }
 
 TEST(SparseLdl, TwoStructuresAliveAtOnce) {

@@ -20,8 +20,9 @@ enum FesdKktMode {
 void fesd_kkt_request_mode(int mode);
 
 /* Cumulative counters of this thread's ma27bd_ calls that ran the sparse factorization:
- * number of calls, thread CPU seconds in them, delayed pivots, re-orderings, and the last
- * matrix's order and entries of the factor. */
+ * number of calls, thread CPU seconds in them, delayed pivots, re-orderings, the last matrix's
+ * order and entries of the factor, and the per-thread scratch memory held after it (front
+ * buffers, contribution blocks: everything outside IPOPT's arrays). */
 struct FesdKktStats {
   long long factorizations;
   double factor_seconds;
@@ -33,6 +34,9 @@ struct FesdKktStats {
   long long last_factor_entries;
   long long reorderings;         /* orderings computed again within a structure (sparse_ldl.cpp) */
   long long reorderings_undone;  /* of them, undone: the factor was not smaller */
+  long long scratch_bytes;       /* the thread's scratch memory after the last factorization */
+  long long rescalings;          /* factorizations done again with the scaling from the identity */
+  long long last_static_entries; /* the last factor's entries without delayed pivots */
 };
 void fesd_kkt_stats(struct FesdKktStats* out);
 void fesd_kkt_reset_stats(void);

@@ -10,7 +10,9 @@
 //    eliminated as (its nonzero-diagonal row, then the zero-diagonal row). Plain AMD put constraint
 //    rows before their variables and delayed a pivot on almost every constraint.
 //  - Symmetric equilibration (three Ruiz sweeps, factors rounded to powers of two): inertia is
-//    kept by congruence and the pivot tests become scale-free.
+//    kept by congruence and the pivot tests become scale-free. From kWarmMinRows rows on, one
+//    sweep from the previous factorization's scaling; done again from the identity when the
+//    factor grows by delayed pivots (kRescaleGrowth).
 //  - Elimination tree (Liu), column counts, supernodes = chains of the tree, relaxed amalgamation
 //    (kRelax); multifrontal factorization in tree order with dense fronts. Computed once per
 //    structure and kept in IW while IPOPT keeps IW.
@@ -29,7 +31,8 @@
 // (KeepSlot)], A = [values (NZ) | scaling (N) | per front its nf x nelim block of L with D on the
 // diagonal and a 2x2 pivot's off-diagonal at L(k+1, k)], IW = [header | pattern (2 NZ) | symbolic
 // analysis (Symbolic) | per front: nf, nelim, offset in A, nf indices, nelim pivot kinds, record
-// start]. Per-thread scratch memory (Workspace) holds no state between calls.
+// start]. Per-thread scratch memory (Workspace: front buffers, the contribution stack) holds no
+// state between calls.
 #include "nlp/kkt/sparse_ldl.hpp"
 
 #include <amd.h>
@@ -115,6 +118,15 @@ constexpr double kMaxPivtol = 0.5;
 constexpr bool kReuseScaling = true;
 constexpr int kWarmMinRows = 1000;
 constexpr int kWarmSweeps = 1;
+/// A factorization with the warm-started scaling whose factor has more than kRescaleGrowth times
+/// the entries of the static fronts (that is, delayed pivots added that many) is done again with
+/// three sweeps from the identity, and the next one starts from that scaling. One sweep from a
+/// scaling carried through hundreds of factorizations drifts away from an equilibrated matrix as
+/// IPOPT's barrier terms change: on row 28's hopper OCP at N_stages 72 (36809 rows;
+/// docs/kkt-solver.md, "Delayed-pivot cascades") the matrices of NLP 0 delayed up to 6.7e5 pivots
+/// (fronts of 1700 rows, 1-5 s per factorization instead of 0.015 s); the same matrices scaled
+/// from the identity delay at most 5500 (factor entries <= 1.06x the static fronts').
+constexpr double kRescaleGrowth = 1.25;
 constexpr int kMaxRefine = 3;
 constexpr double kBerrTarget = 1e-15;
 
@@ -836,19 +848,33 @@ FESD_KKT_KERNEL PivotResult partial_ldlt(int nf, int nfs, double* storage, int* 
   return res;
 }
 
-/// Contribution block a front passes to its parent: the lower triangle (column-major m x m) of its
-/// rows, the first ndelayed of them delayed pivots (their indices in idx), the others the static
-/// front's rows below the fully summed ones (the parent's position map, Symbolic::emap, has them).
+/// Contribution block a front passes to its parent: the lower triangle of its m rows, the first
+/// ndelayed of them delayed pivots (their indices in idx), the others the static front's rows
+/// below the fully summed ones (the parent's position map, Symbolic::emap, has them).
 struct Contribution {
   std::vector<int> idx;  // the delayed pivots (original numbering)
-  std::vector<double> val;
   int ndelayed = 0;
   int m = 0;  // rows of the block
-  /// The block's first entry and leading dimension: in val (m), or in the front buffer it was
-  /// computed in when the parent is the next front.
+  /// Where the block is: packed (column-major lower triangle, m (m + 1) / 2 entries) at offset in
+  /// the workspace's contribution stack, or, when the parent is the next front (offset < 0),
+  /// in place in the front buffer it was computed in, at block with leading dimension ldb.
+  Index offset = -1;
   const double* block = nullptr;
   int ldb = 0;
+  /// Column 0 of the block. Each column is addressed by row (entries jb .. m - 1 of column jb
+  /// are the block's); column jb + 1 starts ldb entries after column jb in place, m - 1 - jb
+  /// packed: step() for column 0, then one less per column when packed().
+  const double* first_column(const double* stack) const {
+    return offset < 0 ? block : stack + offset;
+  }
+  bool packed() const { return offset >= 0; }
+  std::ptrdiff_t step() const { return offset < 0 ? ldb : m - 1; }
 };
+
+/// Packed offset of column j of an m-row lower triangle (its entry (j, j)).
+inline Index packed_column(Index m, Index j) {
+  return j * m - j * (j - 1) / 2;
+}
 
 /// Scratch memory of the factorization, kept per thread between calls (it holds no state: every
 /// call overwrites what it uses). Allocating it per call cost more than the factorization of a
@@ -858,7 +884,25 @@ struct Workspace {
   std::vector<double> rmax, diag, cval, front[2], w1, w2;
   std::vector<int> fidx, kind, lp;
   std::vector<Contribution> cb;
-  std::vector<std::vector<double>> pool;
+  /// The contribution blocks not in place, one after the other in the order they were computed
+  /// (stack_owner: their supernodes). A consumed block is popped once every block above it is
+  /// consumed too; the supernodes come in tree order (children first), mostly a postorder, so the
+  /// live blocks are the stack's top and the stack's length is their peak, about the factor of
+  /// the largest subtree. (A pool of one vector per block, each grown to the largest block it had
+  /// ever held, reached 2.1 GB for 6.5e6 factor entries on the hopper OCP at n_s = 5, and 16.9 GB
+  /// before the out-of-memory killer stopped it: docs/kkt-solver.md, "Memory".)
+  std::vector<double> stack;
+  std::vector<int> stack_owner;
+  /// Bytes held (capacities), for FesdKktStats::scratch_bytes.
+  long long bytes() const {
+    std::size_t b = 0;
+    for (const auto* v : {&rmax, &diag, &cval, &front[0], &front[1], &w1, &w2, &stack})
+      b += v->capacity() * sizeof(double);
+    for (const auto* v : {&fidx, &kind, &lp, &stack_owner}) b += v->capacity() * sizeof(int);
+    b += cb.capacity() * sizeof(Contribution);
+    for (const Contribution& c : cb) b += c.idx.capacity() * sizeof(int);
+    return static_cast<long long>(b);
+  }
 };
 /// The thread's workspace, behind a call: with the thread_local used directly, GCC re-derived its
 /// address (__tls_get_addr) inside the front loop, ~34000 calls per factorization on OCP (61).
@@ -1327,233 +1371,285 @@ FESD_KKT_KERNEL void sparse_factor(int n, int nz, const int* irn, const int* icn
   double* scale = a + nz;
   const auto a_addr = reinterpret_cast<std::uintptr_t>(a);
   const int a_lo = static_cast<int>(a_addr & 0x7fffffffU), a_hi = static_cast<int>(a_addr >> 31);
-  const bool warm = kReuseScaling && n >= kWarmMinRows && cached && n >= kKScaleSlots &&
-                    keep[kKScaled] == 1 && keep[kKLa] == la && keep[kKAAddrLo] == a_lo &&
-                    keep[kKAAddrHi] == a_hi;
-  if (!warm) std::fill_n(scale, n, 1.0);
-  {
-    std::vector<double>& rmax = ws.rmax;
-    rmax.resize(n);
-    // The pattern in IW: 0-based, -1 for out-of-range entries.
-    const int *prow = iw + kHeader, *pcol = prow + nz;
-    // Every triplet in range (the usual case): no per-entry test. The first sweep has scale = 1.
-    const bool all_valid = iw[kHEntries] == nz;
-    const auto sweep = [&]<bool kChecked, bool kFirst>() {
-      std::fill(rmax.begin(), rmax.end(), 0.0);
-      for (int e = 0; e < nz; ++e) {
-        const int i = prow[e], j = pcol[e];
-        if (kChecked && i < 0) continue;
-        const double v = kFirst ? std::abs(a[e]) : std::abs(a[e]) * scale[i] * scale[j];
-        rmax[i] = std::max(rmax[i], v);
-        rmax[j] = std::max(rmax[j], v);
-      }
-      for (int i = 0; i < n; ++i) scale[i] *= inverse_sqrt_pow2(rmax[i]);
-    };
-    if (warm) {
-      for (int k = 0; k < kWarmSweeps; ++k) {
-        if (all_valid)
-          sweep.template operator()<false, false>();
-        else
-          sweep.template operator()<true, false>();
-      }
-    } else if (all_valid) {
-      sweep.template operator()<false, true>();
-      sweep.template operator()<false, false>();
-      sweep.template operator()<false, false>();
-    } else {
-      sweep.template operator()<true, true>();
-      sweep.template operator()<true, false>();
-      sweep.template operator()<true, false>();
-    }
-  }
-  if (n >= kKScaleSlots) {
-    keep[kKScaled] = 1;
-    keep[kKLa] = la;
-    keep[kKAAddrLo] = a_lo;
-    keep[kKAAddrHi] = a_hi;
-  }
-
-  // Scaled values in the permuted lower triangle.
-  std::vector<double>& cval = ws.cval;
-  grow(cval, static_cast<std::size_t>(iw[kHEntries]));  // every entry is written below
-  double amax = 0.0;
-  {
-    const int *prow = iw + kHeader, *pcol = prow + nz;
-    for (int e = 0; e < nz; ++e) {
-      const int i = prow[e];
-      if (i < 0) continue;
-      const double v = a[e] * scale[i] * scale[pcol[e]];
-      amax = std::max(amax, std::abs(v));
-      cval[sym.slot[e]] = v;
-    }
-  }
-  const double tiny = (n >= kLargeKktRows ? kTinyRelLarge : kTinyRel) *
-                      std::max(amax, std::numeric_limits<double>::min());
-  const double u = std::clamp(pivtol, kMinPivtol, kMaxPivtol);
-
-  // Multifrontal factorization; children (smaller last columns) come before their parent.
+  const bool may_warm = kReuseScaling && n >= kWarmMinRows && cached && n >= kKScaleSlots &&
+                        keep[kKScaled] == 1 && keep[kKLa] == la && keep[kKAAddrLo] == a_lo &&
+                        keep[kKAAddrHi] == a_hi;
+  // Working memory of the fronts (scratch, reused between calls) and the factorization's results.
   std::vector<int>&fidx = ws.fidx, &kind = ws.kind;
   std::vector<double>&w1 = ws.w1, &w2 = ws.w2;
   std::vector<int>& w_pos = ws.lp;
   std::vector<Contribution>& cb = ws.cb;
-  std::vector<std::vector<double>>& pool = ws.pool;
+  std::vector<double>& stack = ws.stack;
+  std::vector<int>& stack_owner = ws.stack_owner;
   // Contribution records are reused (their index lists keep their capacity: allocating them per
-  // front was 130000 new / delete per run of OCP (61)); value blocks go back to the pool.
+  // front was 130000 new / delete per run of OCP (61)).
   if (cb.size() < static_cast<std::size_t>(ns)) cb.resize(ns);
-  const auto release = [&pool](Contribution& c) {
-    if (c.val.capacity() > 0) pool.push_back(std::move(c.val));
+  Index stack_top = 0, stack_peak = 0;
+  const auto release = [&](Contribution& c) {
     c.idx.clear();
     c.ndelayed = 0;
     c.m = 0;
+    while (!stack_owner.empty() && cb[stack_owner.back()].m == 0) {
+      stack_top = cb[stack_owner.back()].offset;
+      stack_owner.pop_back();
+    }
   };
-  for (int s = 0; s < ns; ++s) release(cb[s]);
   Index a_next = fixed_la, iw_next = fixed_liw;
   int negative = 0, rank = n, maxnf = 0, nfronts = 0;
   long long delayed = 0;
   bool singular = false;
-  for (int s = 0; s < ns; ++s) {
-    const int nown = cols_ptr[s + 1] - cols_ptr[s];
-    const int* srows = sym.frows + sym.fptr[s];
-    const int nf0 = sym.fptr[s + 1] - sym.fptr[s];
-    // Front order (original numbering): own columns, the children's delayed pivots (children in
-    // order), then the static front's other rows; a static position sp >= nown moves down by nd.
-    int nd = 0;
-    for (int p = cptr[s]; p < cptr[s + 1]; ++p) nd += cb[clist[p]].ndelayed;
-    const int nfs = nown + nd, nf = nf0 + nd;
-    fidx.resize(nf);
-    std::copy_n(srows, nown, fidx.begin());
+  // Pass 0 starts from the previous factorization's scaling when it may (may_warm); if its factor
+  // then has more than kRescaleGrowth times the entries of the static fronts, pass 1 factorizes
+  // again with the scaling from the identity (kRescaleGrowth).
+  const Index static_entries = static_factor_entries(iw);
+  for (int pass = 0;; ++pass) {
+    const bool warm = pass == 0 && may_warm;
+    if (!warm) std::fill_n(scale, n, 1.0);
     {
-      int at = nown;
-      for (int p = cptr[s]; p < cptr[s + 1]; ++p) {
-        const Contribution& ch = cb[clist[p]];
-        at = static_cast<int>(std::copy_n(ch.idx.begin(), ch.ndelayed, fidx.begin() + at) -
-                              fidx.begin());
+      std::vector<double>& rmax = ws.rmax;
+      rmax.resize(n);
+      // The pattern in IW: 0-based, -1 for out-of-range entries.
+      const int *prow = iw + kHeader, *pcol = prow + nz;
+      // Every triplet in range (the usual case): no per-entry test. The first sweep has scale = 1.
+      const bool all_valid = iw[kHEntries] == nz;
+      const auto sweep = [&]<bool kChecked, bool kFirst>() {
+        std::fill(rmax.begin(), rmax.end(), 0.0);
+        for (int e = 0; e < nz; ++e) {
+          const int i = prow[e], j = pcol[e];
+          if (kChecked && i < 0) continue;
+          const double v = kFirst ? std::abs(a[e]) : std::abs(a[e]) * scale[i] * scale[j];
+          rmax[i] = std::max(rmax[i], v);
+          rmax[j] = std::max(rmax[j], v);
+        }
+        for (int i = 0; i < n; ++i) scale[i] *= inverse_sqrt_pow2(rmax[i]);
+      };
+      if (warm) {
+        for (int k = 0; k < kWarmSweeps; ++k) {
+          if (all_valid)
+            sweep.template operator()<false, false>();
+          else
+            sweep.template operator()<true, false>();
+        }
+      } else if (all_valid) {
+        sweep.template operator()<false, true>();
+        sweep.template operator()<false, false>();
+        sweep.template operator()<false, false>();
+      } else {
+        sweep.template operator()<true, true>();
+        sweep.template operator()<true, false>();
+        sweep.template operator()<true, false>();
       }
     }
-    std::copy(srows + nown, srows + nf0, fidx.begin() + nfs);
-    maxnf = std::max(maxnf, nf);
-    const int ld = front_ld(nf);
-    // Fronts alternate between two buffers: a front whose parent comes next leaves its
-    // contribution block in place, and the parent reads it from there (no copy).
-    std::vector<double>& front = ws.front[s & 1];
-    grow(front, static_cast<std::size_t>(ld) * nf);
-    double* fr = front.data();
-    zero_front(fr, nf);
-    const auto shifted = [nown, nd](int sp) { return sp >= nown ? sp + nd : sp; };
-    // The original entries: one flat scatter over the front's entries (column by column, the
-    // columns hold ~4 entries each, and the per-column loop cost more than the scatter).
-    if (nd == 0) {
-#pragma GCC unroll 4
-      for (int q = sym.qptr[s]; q < sym.qptr[s + 1]; ++q) fr[sym.aoff[q]] += cval[q];
-    } else {
-      const int ld0 = front_ld(nf0);
-      for (int q = sym.qptr[s]; q < sym.qptr[s + 1]; ++q) {
-        const int t = sym.aoff[q] / ld0, sp = sym.aoff[q] - t * ld0;
-        fr[static_cast<std::size_t>(t) * ld + shifted(sp)] += cval[q];
+    if (n >= kKScaleSlots) {
+      keep[kKScaled] = 1;
+      keep[kKLa] = la;
+      keep[kKAAddrLo] = a_lo;
+      keep[kKAAddrHi] = a_hi;
+    }
+
+    // Scaled values in the permuted lower triangle.
+    std::vector<double>& cval = ws.cval;
+    grow(cval, static_cast<std::size_t>(iw[kHEntries]));  // every entry is written below
+    double amax = 0.0;
+    {
+      const int *prow = iw + kHeader, *pcol = prow + nz;
+      for (int e = 0; e < nz; ++e) {
+        const int i = prow[e];
+        if (i < 0) continue;
+        const double v = a[e] * scale[i] * scale[pcol[e]];
+        amax = std::max(amax, std::abs(v));
+        cval[sym.slot[e]] = v;
       }
     }
-    int delayed_at = nown;
-    for (int p = cptr[s]; p < cptr[s + 1]; ++p) {
-      Contribution& ch = cb[clist[p]];
-      const int m = ch.m, chd = ch.ndelayed;
-      const int* map = sym.emap + sym.eptr[p];
+    const double tiny = (n >= kLargeKktRows ? kTinyRelLarge : kTinyRel) *
+                        std::max(amax, std::numeric_limits<double>::min());
+    const double u = std::clamp(pivtol, kMinPivtol, kMaxPivtol);
+
+    // Multifrontal factorization; children (smaller last columns) come before their parent.
+    stack_owner.clear();
+    stack_top = 0;
+    for (int s = 0; s < ns; ++s) release(cb[s]);
+    a_next = fixed_la;
+    iw_next = fixed_liw;
+    negative = 0;
+    rank = n;
+    maxnf = 0;
+    nfronts = 0;
+    delayed = 0;
+    singular = false;
+    for (int s = 0; s < ns; ++s) {
+      const int nown = cols_ptr[s + 1] - cols_ptr[s];
+      const int* srows = sym.frows + sym.fptr[s];
+      const int nf0 = sym.fptr[s + 1] - sym.fptr[s];
+      // Front order (original numbering): own columns, the children's delayed pivots (children in
+      // order), then the static front's other rows; a static position sp >= nown moves down by nd.
+      int nd = 0;
+      for (int p = cptr[s]; p < cptr[s + 1]; ++p) nd += cb[clist[p]].ndelayed;
+      const int nfs = nown + nd, nf = nf0 + nd;
+      fidx.resize(nf);
+      std::copy_n(srows, nown, fidx.begin());
+      {
+        int at = nown;
+        for (int p = cptr[s]; p < cptr[s + 1]; ++p) {
+          const Contribution& ch = cb[clist[p]];
+          at = static_cast<int>(std::copy_n(ch.idx.begin(), ch.ndelayed, fidx.begin() + at) -
+                                fidx.begin());
+        }
+      }
+      std::copy(srows + nown, srows + nf0, fidx.begin() + nfs);
+      maxnf = std::max(maxnf, nf);
+      const int ld = front_ld(nf);
+      // Fronts alternate between two buffers: a front whose parent comes next leaves its
+      // contribution block in place, and the parent reads it from there (no copy).
+      std::vector<double>& front = ws.front[s & 1];
+      grow(front, static_cast<std::size_t>(ld) * nf);
+      double* fr = front.data();
+      zero_front(fr, nf);
+      const auto shifted = [nown, nd](int sp) { return sp >= nown ? sp + nd : sp; };
+      // The original entries: one flat scatter over the front's entries (column by column, the
+      // columns hold ~4 entries each, and the per-column loop cost more than the scatter).
       if (nd == 0) {
-        // No delayed pivots (chd = 0 too): the static map as it is, no triangle test. (Vector adds
-        // for runs of consecutive positions, precomputed: as many instructions, no faster.)
-        for (int jb = 0; jb < m; ++jb) {
-          const double* col = ch.block + static_cast<std::size_t>(jb) * ch.ldb;
-          double* fc = fr + static_cast<std::size_t>(map[jb]) * ld;
 #pragma GCC unroll 4
-          for (int ib = jb; ib < m; ++ib) fc[map[ib]] += col[ib];
-        }
+        for (int q = sym.qptr[s]; q < sym.qptr[s + 1]; ++q) fr[sym.aoff[q]] += cval[q];
       } else {
-        // Positions of the child's rows in this front: its delayed pivots, then its static rows.
-        w_pos.resize(m);
-        for (int b = 0; b < chd; ++b) w_pos[b] = delayed_at + b;
-        for (int b = chd; b < m; ++b) w_pos[b] = shifted(map[b - chd]);
-        delayed_at += chd;
-        const int* lp = w_pos.data();
-        for (int jb = 0; jb < m; ++jb) {
-          const int pj = lp[jb];
-          const double* col = ch.block + static_cast<std::size_t>(jb) * ch.ldb;
-          if (jb < chd) {
-            for (int ib = jb; ib < m; ++ib) {
-              const int pi = lp[ib];
-              const auto at = pi >= pj ? static_cast<std::size_t>(pj) * ld + pi
-                                       : static_cast<std::size_t>(pi) * ld + pj;
-              fr[at] += col[ib];
-            }
-          } else {
-            double* fc = fr + static_cast<std::size_t>(pj) * ld;
-#pragma GCC unroll 4
-            for (int ib = jb; ib < m; ++ib) fc[lp[ib]] += col[ib];
-          }
+        const int ld0 = front_ld(nf0);
+        for (int q = sym.qptr[s]; q < sym.qptr[s + 1]; ++q) {
+          const int t = sym.aoff[q] / ld0, sp = sym.aoff[q] - t * ld0;
+          fr[static_cast<std::size_t>(t) * ld + shifted(sp)] += cval[q];
         }
       }
-      release(ch);
-    }
-    grow(kind, nf);
-    const PivotResult pr =
-        partial_ldlt(nf, nfs, front.data(), fidx.data(), kind.data(), u, tiny, w1, w2);
-    const int ne = pr.nelim;
-    negative += pr.negative;
-    if (pr.zero > 0) {
-      singular = true;
-      rank -= pr.zero;
-    }
-    // Record for the solve: L block in A, indices (original numbering) and pivot kinds in IW.
-    const Index a_need = static_cast<Index>(nf) * ne, iw_need = 4 + nf + ne;
-    if (a_next + a_need <= la && iw_next + iw_need <= liw) {
-      for (int j = 0; j < ne; ++j)
-        std::copy_n(fr + static_cast<std::size_t>(j) * ld, nf,
-                    a + a_next + static_cast<Index>(j) * nf);
-      int* rec = iw + iw_next;
-      rec[0] = nf;
-      rec[1] = ne;
-      rec[2] = static_cast<int>(a_next);
-      std::copy_n(fidx.data(), nf, rec + 3);
-      std::copy_n(kind.data(), ne, rec + 3 + nf);
-      rec[3 + nf + ne] = static_cast<int>(iw_next);
-    }
-    a_next += a_need;
-    iw_next += iw_need;
-    ++nfronts;
-    const int m = nf - ne;
-    delayed += nfs - ne;
-    if (m > 0) {
-      if (sparent[s] < 0) {
-        // Only delayed pivots remain at a root: zero to round-off.
-        singular = true;
-        rank -= m;
-      } else {
-        // The block's rows: the pivots delayed to the parent (indices kept), then the static
-        // front's rows below the fully summed ones (the parent's emap has their positions).
-        Contribution& out = cb[s];
-        out.idx.assign(fidx.begin() + ne, fidx.begin() + nfs);
-        out.ndelayed = nfs - ne;
-        out.m = m;
-        if (sparent[s] == s + 1) {  // in place (the next front uses the other buffer)
-          out.block = fr + static_cast<std::size_t>(ne) * ld + ne;
-          out.ldb = ld;
+      int delayed_at = nown;
+      for (int p = cptr[s]; p < cptr[s + 1]; ++p) {
+        Contribution& ch = cb[clist[p]];
+        const int m = ch.m, chd = ch.ndelayed;
+        const int* map = sym.emap + sym.eptr[p];
+        if (nd == 0) {
+          // No delayed pivots (chd = 0 too): the static map as it is, no triangle test. (Vector
+          // adds for runs of consecutive positions, precomputed: as many instructions, no faster.)
+          const double* col0 = ch.first_column(stack.data());
+          const std::ptrdiff_t packed = ch.packed();
+          std::ptrdiff_t at = 0, step = ch.step();
+          for (int jb = 0; jb < m; ++jb, at += step, step -= packed) {
+            const double* col = col0 + at;
+            double* fc = fr + static_cast<std::size_t>(map[jb]) * ld;
+#pragma GCC unroll 4
+            for (int ib = jb; ib < m; ++ib) fc[map[ib]] += col[ib];
+          }
         } else {
-          if (!pool.empty()) {
-            out.val = std::move(pool.back());
-            pool.pop_back();
+          // Positions of the child's rows in this front: its delayed pivots, then its static rows.
+          w_pos.resize(m);
+          for (int b = 0; b < chd; ++b) w_pos[b] = delayed_at + b;
+          for (int b = chd; b < m; ++b) w_pos[b] = shifted(map[b - chd]);
+          delayed_at += chd;
+          const int* lp = w_pos.data();
+          const double* col0 = ch.first_column(stack.data());
+          const std::ptrdiff_t packed = ch.packed();
+          std::ptrdiff_t at = 0, step = ch.step();
+          for (int jb = 0; jb < m; ++jb, at += step, step -= packed) {
+            const double* col = col0 + at;
+            const int pj = lp[jb];
+            if (jb < chd) {
+              for (int ib = jb; ib < m; ++ib) {
+                const int pi = lp[ib];
+                const auto to = pi >= pj ? static_cast<std::size_t>(pj) * ld + pi
+                                         : static_cast<std::size_t>(pi) * ld + pj;
+                fr[to] += col[ib];
+              }
+            } else {
+              double* fc = fr + static_cast<std::size_t>(pj) * ld;
+#pragma GCC unroll 4
+              for (int ib = jb; ib < m; ++ib) fc[lp[ib]] += col[ib];
+            }
           }
-          grow(out.val, static_cast<std::size_t>(m) * m);
-          for (int j = 0; j < m; ++j)  // lower triangle
-            std::copy_n(fr + static_cast<std::size_t>(ne + j) * ld + ne + j, m - j,
-                        out.val.data() + static_cast<std::size_t>(j) * m + j);
-          out.block = out.val.data();
-          out.ldb = m;
+        }
+        release(ch);
+      }
+      grow(kind, nf);
+      const PivotResult pr =
+          partial_ldlt(nf, nfs, front.data(), fidx.data(), kind.data(), u, tiny, w1, w2);
+      const int ne = pr.nelim;
+      negative += pr.negative;
+      if (pr.zero > 0) {
+        singular = true;
+        rank -= pr.zero;
+      }
+      // Record for the solve: L block in A, indices (original numbering) and pivot kinds in IW.
+      const Index a_need = static_cast<Index>(nf) * ne, iw_need = 4 + nf + ne;
+      if (a_next + a_need <= la && iw_next + iw_need <= liw) {
+        for (int j = 0; j < ne; ++j)
+          std::copy_n(fr + static_cast<std::size_t>(j) * ld, nf,
+                      a + a_next + static_cast<Index>(j) * nf);
+        int* rec = iw + iw_next;
+        rec[0] = nf;
+        rec[1] = ne;
+        rec[2] = static_cast<int>(a_next);
+        std::copy_n(fidx.data(), nf, rec + 3);
+        std::copy_n(kind.data(), ne, rec + 3 + nf);
+        rec[3 + nf + ne] = static_cast<int>(iw_next);
+      }
+      a_next += a_need;
+      iw_next += iw_need;
+      ++nfronts;
+      const int m = nf - ne;
+      delayed += nfs - ne;
+      if (m > 0) {
+        if (sparent[s] < 0) {
+          // Only delayed pivots remain at a root: zero to round-off.
+          singular = true;
+          rank -= m;
+        } else {
+          // The block's rows: the pivots delayed to the parent (indices kept), then the static
+          // front's rows below the fully summed ones (the parent's emap has their positions).
+          Contribution& out = cb[s];
+          out.idx.assign(fidx.begin() + ne, fidx.begin() + nfs);
+          out.ndelayed = nfs - ne;
+          out.m = m;
+          if (sparent[s] == s + 1) {  // in place (the next front uses the other buffer)
+            out.offset = -1;
+            out.block = fr + static_cast<std::size_t>(ne) * ld + ne;
+            out.ldb = ld;
+          } else {
+            const Index size = static_cast<Index>(m) * (m + 1) / 2;
+            if (stack_top + size > static_cast<Index>(stack.size())) {
+              // Grown by half (reserve: exactly that capacity; resize alone would double it).
+              const auto len = static_cast<std::size_t>(
+                  std::max(stack_top + size, static_cast<Index>(stack.size() + stack.size() / 2)));
+              stack.reserve(len);
+              stack.resize(len);
+            }
+            out.offset = stack_top;
+            out.block = nullptr;
+            out.ldb = 0;
+            double* dst = stack.data() + stack_top;
+            for (int j = 0; j < m; ++j)  // lower triangle, packed
+              std::copy_n(fr + static_cast<std::size_t>(ne + j) * ld + ne + j, m - j,
+                          dst + packed_column(m, j));
+            stack_owner.push_back(s);
+            stack_top += size;
+            stack_peak = std::max(stack_peak, stack_top);
+          }
         }
       }
     }
+    if (warm && static_cast<double>(a_next - fixed_la) >
+                    kRescaleGrowth * static_cast<double>(static_entries)) {
+      if (stats != nullptr) ++stats->rescalings;
+      continue;
+    }
+    break;
+  }
+  // After an outlier (a delayed-pivot cascade), give the memory back once the stack is far
+  // larger than this factorization needed.
+  if (static_cast<Index>(stack.size()) > std::max<Index>(4 * stack_peak, Index{1} << 23)) {
+    stack.resize(static_cast<std::size_t>(stack_peak));
+    stack.shrink_to_fit();
   }
   if (stats != nullptr) {
     stats->delayed_pivots += delayed;
     stats->last_n = n;
     stats->last_factor_entries = a_next - fixed_la;
+    stats->scratch_bytes = ws.bytes();
+    stats->last_static_entries = static_entries;
   }
   if (a_next > la || iw_next > liw) {
     info[0] = a_next > la ? -4 : -3;
