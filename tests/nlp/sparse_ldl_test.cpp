@@ -406,18 +406,25 @@ TEST(SparseLdl, OrderingComputedAgainWhenFewerDiagonalsAreZeroUndoneIfNotSmaller
   EXPECT_LT(small.berr, 1e-14);
 }
 
+/// nosnoc_py's hopper OCP (examples/nosnoc/hopper_ocp.toml, 25567 KKT rows) cut to `nlps` NLPs of
+/// at most `max_iter` IPOPT iterations each, on the sparse LDL'.
+fesd::OcpProblem short_hopper_ocp(int nlps, int max_iter) {
+  fesd::OcpProblem p =
+      fesd::load_ocp_problem(std::string(FESD_SOURCE_DIR) + "/examples/nosnoc/hopper_ocp.toml");
+  p.options.homotopy.max_homotopy_steps = nlps;
+  p.options.homotopy.homotopy_retries = 0;
+  p.options.nlp.max_iter = max_iter;
+  p.options.nlp.kkt_solver = fesd::KktSolver::SparseLdl;
+  return p;
+}
+
 // The case the re-ordering is for: nosnoc_py's hopper OCP (examples/nosnoc/hopper_ocp.toml, 25567
 // KKT rows). NLP 1's structure is matched on an unperturbed matrix; its first perturbed matrix
 // has fewer zero diagonals and an ordering with 0.69x the static factor entries (measured:
 // 1.96e6 -> 1.35e6), which is kept. 15 IPOPT iterations per NLP are enough to get there.
 TEST(SparseLdl, HopperOcpKeepsTheOrderingOfItsPerturbedMatrices) {
   ASSERT_NE(module().stats, nullptr);
-  fesd::OcpProblem p =
-      fesd::load_ocp_problem(std::string(FESD_SOURCE_DIR) + "/examples/nosnoc/hopper_ocp.toml");
-  p.options.homotopy.max_homotopy_steps = 2;
-  p.options.homotopy.homotopy_retries = 0;
-  p.options.nlp.max_iter = 15;
-  p.options.nlp.kkt_solver = fesd::KktSolver::SparseLdl;
+  const fesd::OcpProblem p = short_hopper_ocp(2, 15);
   const FesdKktStats before = kkt_stats();
   const fesd::OcpResult r = fesd::solve(p.ocp, p.options);
   const FesdKktStats after = kkt_stats();
@@ -437,12 +444,7 @@ TEST(SparseLdl, HopperOcpKeepsTheOrderingOfItsPerturbedMatrices) {
 // with the pool 28.9 MB.
 TEST(SparseLdl, ScratchMemoryIsAFractionOfTheFactorOnTheHopperOcp) {
   ASSERT_NE(module().stats, nullptr);
-  fesd::OcpProblem p =
-      fesd::load_ocp_problem(std::string(FESD_SOURCE_DIR) + "/examples/nosnoc/hopper_ocp.toml");
-  p.options.homotopy.max_homotopy_steps = 3;
-  p.options.homotopy.homotopy_retries = 0;
-  p.options.nlp.max_iter = 20;
-  p.options.nlp.kkt_solver = fesd::KktSolver::SparseLdl;
+  const fesd::OcpProblem p = short_hopper_ocp(3, 20);
   FesdKktStats after{};
   // A thread of its own: the scratch memory is per thread, this one starts with none.
   std::thread([&] {
