@@ -119,8 +119,15 @@ constexpr bool kReuseScaling = true;
 constexpr int kWarmMinRows = 1000;
 constexpr int kWarmSweeps = 1;
 /// A factorization with the warm-started scaling whose factor has more than kRescaleGrowth times
-/// the entries of the static fronts (that is, delayed pivots added that many) is done again with
-/// three sweeps from the identity, and the next one starts from that scaling. One sweep from a
+/// the entries of the static fronts (that is, delayed pivots added that many), and of the last
+/// factor of the structure done again this way, is done again with three sweeps from the
+/// identity, and the next one starts from that scaling. (Without the second bound, a matrix whose
+/// own delayed pivots grow its factor by more than kRescaleGrowth whatever the scaling was
+/// factorized twice at every call: 1.7-2x the time, found in review.) A warm-scaled factorization
+/// that reports the matrix singular is done again too, unless the last one done again was
+/// singular as well: a drifted scaling also makes pivots "zero" (<= tiny) that are not, and IPOPT
+/// then regularizes a nonsingular matrix (in review, 8 of 600 random trials; the test
+/// SparseLdl.DriftedWarmScalingIsStartedAfresh). One sweep from a
 /// scaling carried through hundreds of factorizations drifts away from an equilibrated matrix as
 /// IPOPT's barrier terms change: on row 28's hopper OCP at N_stages 72 (36809 rows;
 /// docs/kkt-solver.md, "Delayed-pivot cascades") the matrices of NLP 0 delayed up to 6.7e5 pivots
@@ -167,6 +174,8 @@ enum KeepSlot {
   kKFactorizations,             // factorizations since MA27AD, counted up to kReorderChecks
   kKStaticEntries,              // factor entries of the symbolic analysis in IW (static fronts)
   kKCompare,                    // 1: the ordering is new, compare with kKStaticEntries
+  kKFreshEntries,   // factor entries of the last factorization done again (kRescaleGrowth; 0: none)
+  kKFreshSingular,  // 1: that factorization was singular too
   kKOrderSlots
 };
 
@@ -1398,10 +1407,17 @@ FESD_KKT_KERNEL void sparse_factor(int n, int nz, const int* irn, const int* icn
   int negative = 0, rank = n, maxnf = 0, nfronts = 0;
   long long delayed = 0;
   bool singular = false;
-  // Pass 0 starts from the previous factorization's scaling when it may (may_warm); if its factor
-  // then has more than kRescaleGrowth times the entries of the static fronts, pass 1 factorizes
-  // again with the scaling from the identity (kRescaleGrowth).
+  // Pass 0 starts from the previous factorization's scaling when it may (may_warm). Pass 1
+  // factorizes again with the scaling from the identity (kRescaleGrowth) if pass 0's factor has
+  // more than kRescaleGrowth times the entries of the static fronts, or of the last factor of
+  // this structure that pass 1 gave if that had more (delayed pivots that the matrix itself
+  // causes, which a fresh scaling does not remove); or if pass 0 found the matrix singular, unless
+  // the last pass 1 of this structure found it singular too.
   const Index static_entries = static_factor_entries(iw);
+  const bool has_slots = n >= kKOrderSlots;
+  const Index fresh_entries =
+      has_slots ? std::max<Index>(static_entries, keep[kKFreshEntries]) : static_entries;
+  bool rescaled = false;
   for (int pass = 0;; ++pass) {
     const bool warm = pass == 0 && may_warm;
     if (!warm) std::fill_n(scale, n, 1.0);
@@ -1631,12 +1647,19 @@ FESD_KKT_KERNEL void sparse_factor(int n, int nz, const int* irn, const int* icn
         }
       }
     }
-    if (warm && static_cast<double>(a_next - fixed_la) >
-                    kRescaleGrowth * static_cast<double>(static_entries)) {
+    const bool grown = static_cast<double>(a_next - fixed_la) >
+                       kRescaleGrowth * static_cast<double>(fresh_entries);
+    if (warm && (grown || (singular && !(has_slots && keep[kKFreshSingular] == 1)))) {
       if (stats != nullptr) ++stats->rescalings;
+      rescaled = true;
       continue;
     }
     break;
+  }
+  if (rescaled && has_slots) {
+    keep[kKFreshEntries] =
+        static_cast<int>(std::min<Index>(a_next - fixed_la, std::numeric_limits<int>::max()));
+    keep[kKFreshSingular] = singular ? 1 : 0;
   }
   // After an outlier (a delayed-pivot cascade), give the memory back once the stack is far
   // larger than this factorization needed.
