@@ -23,15 +23,18 @@ struct HomotopyRow {
   double inf_pr = 0;         ///< IPOPT's final primal infeasibility
   int nlp_iterations = 0;
   std::string nlp_status;  ///< IPOPT's return status, e.g. "Solve_Succeeded"
+  /// CPU time of the solving thread (IPOPT, derivatives, KKT solves; threads of a BLAS not
+  /// counted) and wall time of the NLP. Until 2026-11-29 cpu_s held the wall time.
   double cpu_s = 0;
+  double wall_s = 0;
   /// KKT solver IPOPT used: "dense" (LAPACK LDL', small NLPs), "sparse_ldl", "mumps", or, for a
   /// retried NLP, the last run's with what it changed and the failed runs, e.g. "sparse_ldl (again
   /// with mu_strategy monotone from mu_init 0.0001; first run: STATUS after N iterations)", a
   /// warm start that ran monotone first because an NLP before needed it ("sparse_ldl (mu_strategy
   /// monotone from mu_init 0.0001, as an NLP before needed)"), or
   /// "mumps (sparse_ldl fallback; first run: ...; again with ma27_pivtol 0.01: ...)"
-  /// (NlpOptions::kkt_solver, NlpOptions::extra; nlp_iterations and cpu_s then count every run,
-  /// factor_s and factorizations the last one's).
+  /// (NlpOptions::kkt_solver, NlpOptions::extra; nlp_iterations, cpu_s and wall_s then count every
+  /// run, factor_s and factorizations the last one's).
   std::string linear_solver;
   /// Wall time of IPOPT's KKT factorizations, and their number with fesd's sparse LDL' (0 else).
   double factor_s = 0;

@@ -287,7 +287,7 @@ class SimulationResult(_Result):
       switches (list of dict): t, element, before, after (regions), located; switch_times
           (array of their t).
       homotopy (list of lists of dict): per solve attempt the homotopy rows (k, sigma,
-          comp_residual, objective, inf_pr, nlp_iterations, nlp_status, cpu_s, ...); steps solved
+          comp_residual, objective, inf_pr, nlp_iterations, nlp_status, cpu_s, wall_s, ...); steps solved
           on the active-set path have none.
       summary (dict): work and time (homotopy_steps, nlp_iterations, wall_s, derivative_s,
           solver_s, setup_s, max_comp_residual, active_set_path_steps, newton_iterations, ...,

@@ -141,6 +141,7 @@ py::dict homotopy_row(const fesd::HomotopyRow& r) {
   d["nlp_iterations"] = r.nlp_iterations;
   d["nlp_status"] = r.nlp_status;
   d["cpu_s"] = r.cpu_s;
+  d["wall_s"] = r.wall_s;
   d["linear_solver"] = r.linear_solver;
   d["factor_s"] = r.factor_s;
   d["factorizations"] = r.factorizations;

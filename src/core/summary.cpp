@@ -24,7 +24,7 @@ std::string homotopy_table_header() {
 std::string format_homotopy_row(const HomotopyRow& r) {
   std::string row = fmt::format(
       "{:>4} {:>9.1e} {:>10.2e} {:>14.7e} {:>9.1e} {:>5}  {:<26} {:>8.3f}", r.k, r.sigma,
-      r.comp_residual, r.objective, r.inf_pr, r.nlp_iterations, r.nlp_status, r.cpu_s);
+      r.comp_residual, r.objective, r.inf_pr, r.nlp_iterations, r.nlp_status, r.wall_s);
   if (r.active_set_fixed)
     row += r.pinned_exits > 0
                ? fmt::format("  (the last NLP again, active set fixed, {} sliding exit{} pinned)",

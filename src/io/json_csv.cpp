@@ -137,6 +137,7 @@ json homotopy_row(const HomotopyRow& r) {
               {"nlp_iterations", r.nlp_iterations},
               {"nlp_status", r.nlp_status},
               {"cpu_s", number(r.cpu_s)},
+              {"wall_s", number(r.wall_s)},
               {"linear_solver", r.linear_solver},
               {"factor_s", number(r.factor_s)},
               {"factorizations", r.factorizations},

@@ -32,7 +32,8 @@ void record(HomotopyResult& res, const nlp::NlpResult& r, int k, double sigma) {
   row.inf_pr = r.inf_pr;
   row.nlp_iterations = r.iterations;
   row.nlp_status = r.status;
-  row.cpu_s = r.total_s;
+  row.cpu_s = r.cpu_s;
+  row.wall_s = r.total_s;
   row.linear_solver = r.linear_solver;
   row.factor_s = r.factor_s;
   row.factorizations = r.factorizations;

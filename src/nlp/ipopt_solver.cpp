@@ -348,6 +348,7 @@ std::vector<std::string> warnings(const NlpOptions& o) {
 NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_start, double tol,
                              int max_iter) {
   const auto t0 = Clock::now();
+  const double cpu0 = util::thread_cpu_seconds();
   Ipopt::IpoptApplication& app = *impl_->app;
   app.Options()->SetNumericValue("tol", std::max(tol, impl_->tol));
   app.Options()->SetIntegerValue(
@@ -492,6 +493,7 @@ NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_star
           -1, "sparse_ldl fallback", [] {}, [] {});
   }
   r.total_s = seconds_since(t0);
+  r.cpu_s = util::thread_cpu_seconds() - cpu0;
   return r;
 }
 

@@ -33,6 +33,7 @@ struct NlpResult {
   double objective = 0, inf_pr = 0, inf_du = 0;
   double eval_s = 0;   ///< time spent in function and derivative evaluations
   double total_s = 0;  ///< wall time of the whole solve
+  double cpu_s = 0;    ///< CPU time of the calling thread in the whole solve (not other threads')
   /// Wall time in IPOPT's factorizations (its LinearSystemFactorization timer), and the number of
   /// factorizations when fesd's KKT module ran them (0 with MUMPS). Of the run reported.
   double factor_s = 0;

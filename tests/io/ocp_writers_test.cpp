@@ -73,8 +73,8 @@ fesd::OcpResult make_result() {
   r.theta = {vec({0.0, 1.0}), vec({1.0, 0.0}), vec({1.0, 0.0}), vec({1.0, 0.0})};
   r.lambda = {vec({2.0, 0.0}), vec({0.0, 2.0}), vec({0.0, 2.0}), vec({0.0, 2.0})};
   r.homotopy = {
-      fesd::HomotopyRow{0, 1.0, 0.5, 2.0, 1e-12, 7, "Solve_Succeeded", 0.001, "mumps"},
-      fesd::HomotopyRow{1, 0.1, 1e-10, 1.25, 2e-13, 3, "Solve_Succeeded", 0.002, "mumps"}};
+      fesd::HomotopyRow{0, 1.0, 0.5, 2.0, 1e-12, 7, "Solve_Succeeded", 0.001, 0.001, "mumps"},
+      fesd::HomotopyRow{1, 0.1, 1e-10, 1.25, 2e-13, 3, "Solve_Succeeded", 0.002, 0.002, "mumps"}};
   r.homotopy[0].retried = true;
   r.summary.homotopy_steps = 2;
   r.summary.nlp_iterations = 10;

@@ -70,10 +70,11 @@ fesd::IntegratorResult make_result() {
   r.active_set = {{1}, {0}, {0}, {0}};
   r.switches = {fesd::SwitchEvent{.t = 1.0 / 3.0, .element = 0, .before = {1}, .after = {0}}};
   r.homotopy = {
-      {fesd::HomotopyRow{0, 1.0, 0.5, 0.25, 1e-12, 7, "Solve_Succeeded", 0.001, "dense"},
-       fesd::HomotopyRow{1, 0.1, 1e-10, 0.125, 2e-13, 3, "Solve_Succeeded", 0.0005, "dense"}},
+      {fesd::HomotopyRow{0, 1.0, 0.5, 0.25, 1e-12, 7, "Solve_Succeeded", 0.001, 0.001, "dense"},
+       fesd::HomotopyRow{1, 0.1, 1e-10, 0.125, 2e-13, 3, "Solve_Succeeded", 0.0005, 0.0007,
+                         "dense"}},
       {fesd::HomotopyRow{0, 1.0, std::numeric_limits<double>::infinity(), 0.0, 0.0, 500,
-                         "Maximum_Iterations_Exceeded", 0.25, "mumps"}},
+                         "Maximum_Iterations_Exceeded", 0.25, 0.25, "mumps"}},
   };
   r.summary = fesd::Summary{.homotopy_steps = 3,
                             .nlp_iterations = 510,
@@ -182,6 +183,7 @@ TEST(WriteJson, HasEveryKeyAndRoundTripsValues) {
   EXPECT_EQ(row["nlp_iterations"], 3);
   EXPECT_EQ(row["nlp_status"], "Solve_Succeeded");
   EXPECT_EQ(row["cpu_s"], 0.0005);
+  EXPECT_EQ(row["wall_s"], 0.0007);
   EXPECT_TRUE(j["homotopy"][1][0]["comp_residual"].is_null());  // inf
   EXPECT_EQ(j["homotopy"][1][0]["nlp_status"], "Maximum_Iterations_Exceeded");
 }
