@@ -134,6 +134,11 @@ constexpr int kWarmSweeps = 1;
 /// (fronts of 1700 rows, 1-5 s per factorization instead of 0.015 s); the same matrices scaled
 /// from the identity delay at most 5500 (factor entries <= 1.06x the static fronts').
 constexpr double kRescaleGrowth = 1.25;
+/// The fresh start above, switched off: with it rows 30, 31 and 32 of docs/nosnoc-examples.md
+/// got worse (row 32's NLP 1 at max_iter 5000 where it solved in 2307 iterations, row 30's NLP 1
+/// not done after 10 min CPU where the whole run took 165 s wall; docs/kkt-solver.md,
+/// "Delayed-pivot cascades"). Off, every factor is the one of the module before, bit for bit.
+constexpr bool kFreshScaling = false;
 constexpr int kMaxRefine = 3;
 constexpr double kBerrTarget = 1e-15;
 
@@ -1649,7 +1654,8 @@ FESD_KKT_KERNEL void sparse_factor(int n, int nz, const int* irn, const int* icn
     }
     const bool grown = static_cast<double>(a_next - fixed_la) >
                        kRescaleGrowth * static_cast<double>(fresh_entries);
-    if (warm && (grown || (singular && !(has_slots && keep[kKFreshSingular] == 1)))) {
+    if (kFreshScaling && warm &&
+        (grown || (singular && !(has_slots && keep[kKFreshSingular] == 1)))) {
       if (stats != nullptr) ++stats->rescalings;
       rescaled = true;
       continue;
