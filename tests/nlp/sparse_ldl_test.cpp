@@ -389,8 +389,8 @@ TEST(SparseLdl, OrderingComputedAgainWhenFewerDiagonalsAreZeroUndoneIfNotSmaller
   // Random KKT matrices: the ordering of the perturbed matrix has about the static factor size of
   // the one matched on the unperturbed matrix (random coupling fills either way), so the
   // re-ordering is undone before anything is factorized with it: every factor of the structure
-  // has the static fronts of the old ordering (entries without delayed pivots: those depend on the
-  // scaling, which a factorization may have started afresh, kRescaleGrowth).
+  // has the static fronts of the old ordering (entries without delayed pivots, which depend on the
+  // warm-started scaling).
   for (int every : {2, 3}) {
     const ReorderRun r = reorder_run(3000, 2200, every);  // 5200 rows
     EXPECT_EQ(r.reorders_first, 0) << every;
@@ -458,77 +458,6 @@ TEST(SparseLdl, ScratchMemoryIsAFractionOfTheFactorOnTheHopperOcp) {
   EXPECT_GT(after.scratch_bytes, 0);
   EXPECT_LT(static_cast<double>(after.scratch_bytes), 1.5 * factor_bytes)
       << after.scratch_bytes << " bytes of scratch for a factor of " << factor_bytes << " bytes";
-}
-
-// From 1000 rows on, a factorization starts from the previous one's scaling and does one Ruiz
-// sweep. When the diagonal has moved by orders of magnitude (IPOPT's barrier terms), that sweep
-// leaves the matrix far from equilibrated, pivots fail the threshold test and are delayed; a
-// factor with more than 1.25x the static fronts' entries is done again with the scaling from the
-// identity (sparse_ldl.cpp, kRescaleGrowth; docs/kkt-solver.md, "Delayed-pivot cascades").
-// Disabled with the fresh start (sparse_ldl.cpp, kFreshScaling = false).
-TEST(SparseLdl, DISABLED_DriftedWarmScalingIsStartedAfresh) {
-  ASSERT_NE(module().stats, nullptr);
-  std::mt19937 rng(31);
-  const int nx = 1500, m = 1000;
-  const Triplets a = random_kkt(rng, nx, m, 0.0);
-  // b = D a D, the same matrix in other units, D_i = 2^20 or 2^-20 at random: one sweep from a's
-  // scaling takes b's only half-way (in log scale) to equilibrium, and one from b's takes a's
-  // half-way back. Without the fresh start b's factorization reports the matrix singular (pivots
-  // <= tiny in the drifted scaling), with the growth test alone too; the error is checked in a's
-  // units (review: b's normwise error alone is dominated by its 2^40 entries).
-  Triplets b = a;
-  std::vector<double> d(static_cast<std::size_t>(a.n));
-  for (double& di : d) di = (rng() % 2 == 0) ? std::ldexp(1.0, 20) : std::ldexp(1.0, -20);
-  for (int e = 0; e < b.nz(); ++e) b.val[e] *= d[b.irn[e] - 1] * d[b.icn[e] - 1];
-  const Eigen::Map<const Eigen::VectorXd> dv(d.data(), a.n);
-  Ma27 solver(a, FESD_KKT_SPARSE);
-  const Eigen::VectorXd rhs = Eigen::VectorXd::LinSpaced(a.n, -1, 2);
-  const long long before = kkt_stats().rescalings;
-  for (int k = 0; k < 6; ++k) {
-    const bool in_a = k % 2 == 0;
-    ASSERT_EQ(solver.factor(in_a ? a.val : b.val), 0) << k;
-    const FesdKktStats st = kkt_stats();
-    EXPECT_LE(static_cast<double>(st.last_factor_entries),
-              1.25 * static_cast<double>(st.last_static_entries))
-        << k;
-    // The error in a's units: b (D^-1 x) = D rhs for a x = rhs.
-    const Eigen::VectorXd x =
-        in_a ? solver.solve(rhs)
-             : Eigen::VectorXd(dv.cwiseProduct(solver.solve(dv.cwiseProduct(rhs))));
-    EXPECT_LT(sparse_backward_error(a, x, rhs), 1e-14) << k;
-  }
-  EXPECT_GE(kkt_stats().rescalings - before, 1);
-}
-
-// The other way round: delayed pivots that the matrix causes whatever its scaling (zero
-// constraint diagonals, the ordering matched on -1 there, so no constraint row is paired with a
-// variable) grow the factor past kRescaleGrowth every time; the fresh start, which does not help
-// there, is not repeated at every factorization (it was, 1.7-2x the time, until review).
-// Disabled with the fresh start (sparse_ldl.cpp, kFreshScaling = false).
-TEST(SparseLdl, DISABLED_DelayedPivotsOfTheMatrixItselfAreNotFactorizedTwiceEachTime) {
-  ASSERT_NE(module().stats, nullptr);
-  std::mt19937 rng(21);
-  int cases = 0;
-  for (int trial = 0; trial < 6; ++trial) {
-    const Triplets z = random_kkt(rng, 1500, 1000, 0.0);
-    Triplets t = z;
-    for (int e = 0; e < t.nz(); ++e)
-      if (t.irn[e] == t.icn[e] && t.irn[e] > 1500) t.val[e] = -1.0;
-    Ma27 solver(t, FESD_KKT_SPARSE);
-    ASSERT_EQ(solver.factor(t.val), 0) << trial;
-    const long long before = kkt_stats().rescalings;
-    bool grown = true;
-    for (int k = 0; k < 5; ++k) {
-      ASSERT_GE(solver.factor(z.val), 0) << trial;
-      const FesdKktStats st = kkt_stats();
-      grown = grown && static_cast<double>(st.last_factor_entries) >
-                           1.25 * static_cast<double>(st.last_static_entries);
-    }
-    if (!grown) continue;
-    ++cases;
-    EXPECT_LE(kkt_stats().rescalings - before, 1) << trial;
-  }
-  EXPECT_GE(cases, 2);
 }
 
 TEST(SparseLdl, TwoStructuresAliveAtOnce) {

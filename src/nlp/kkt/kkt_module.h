@@ -35,7 +35,6 @@ struct FesdKktStats {
   long long reorderings;         /* orderings computed again within a structure (sparse_ldl.cpp) */
   long long reorderings_undone;  /* of them, undone: the factor was not smaller */
   long long scratch_bytes;       /* the thread's scratch memory after the last factorization */
-  long long rescalings;          /* factorizations done again with the scaling from the identity */
   long long last_static_entries; /* the last factor's entries without delayed pivots */
 };
 void fesd_kkt_stats(struct FesdKktStats* out);

@@ -10,9 +10,7 @@
 //    eliminated as (its nonzero-diagonal row, then the zero-diagonal row). Plain AMD put constraint
 //    rows before their variables and delayed a pivot on almost every constraint.
 //  - Symmetric equilibration (three Ruiz sweeps, factors rounded to powers of two): inertia is
-//    kept by congruence and the pivot tests become scale-free. From kWarmMinRows rows on, one
-//    sweep from the previous factorization's scaling; done again from the identity when the
-//    factor grows by delayed pivots (kRescaleGrowth).
+//    kept by congruence and the pivot tests become scale-free.
 //  - Elimination tree (Liu), column counts, supernodes = chains of the tree, relaxed amalgamation
 //    (kRelax); multifrontal factorization in tree order with dense fronts. Computed once per
 //    structure and kept in IW while IPOPT keeps IW.
@@ -118,27 +116,6 @@ constexpr double kMaxPivtol = 0.5;
 constexpr bool kReuseScaling = true;
 constexpr int kWarmMinRows = 1000;
 constexpr int kWarmSweeps = 1;
-/// A factorization with the warm-started scaling whose factor has more than kRescaleGrowth times
-/// the entries of the static fronts (that is, delayed pivots added that many), and of the last
-/// factor of the structure done again this way, is done again with three sweeps from the
-/// identity, and the next one starts from that scaling. (Without the second bound, a matrix whose
-/// own delayed pivots grow its factor by more than kRescaleGrowth whatever the scaling was
-/// factorized twice at every call: 1.7-2x the time, found in review.) A warm-scaled factorization
-/// that reports the matrix singular is done again too, unless the last one done again was
-/// singular as well: a drifted scaling also makes pivots "zero" (<= tiny) that are not, and IPOPT
-/// then regularizes a nonsingular matrix (in review, 8 of 600 random trials; the test
-/// SparseLdl.DriftedWarmScalingIsStartedAfresh). One sweep from a
-/// scaling carried through hundreds of factorizations drifts away from an equilibrated matrix as
-/// IPOPT's barrier terms change: on row 28's hopper OCP at N_stages 72 (36809 rows;
-/// docs/kkt-solver.md, "Delayed-pivot cascades") the matrices of NLP 0 delayed up to 6.7e5 pivots
-/// (fronts of 1700 rows, 1-5 s per factorization instead of 0.015 s); the same matrices scaled
-/// from the identity delay at most 5500 (factor entries <= 1.06x the static fronts').
-constexpr double kRescaleGrowth = 1.25;
-/// The fresh start above, switched off: with it rows 30, 31 and 32 of docs/nosnoc-examples.md
-/// got worse (row 32's NLP 1 at max_iter 5000 where it solved in 2307 iterations, row 30's NLP 1
-/// not done after 10 min CPU where the whole run took 165 s wall; docs/kkt-solver.md,
-/// "Delayed-pivot cascades"). Off, every factor is the one of the module before, bit for bit.
-constexpr bool kFreshScaling = false;
 constexpr int kMaxRefine = 3;
 constexpr double kBerrTarget = 1e-15;
 
@@ -179,8 +156,6 @@ enum KeepSlot {
   kKFactorizations,             // factorizations since MA27AD, counted up to kReorderChecks
   kKStaticEntries,              // factor entries of the symbolic analysis in IW (static fronts)
   kKCompare,                    // 1: the ordering is new, compare with kKStaticEntries
-  kKFreshEntries,   // factor entries of the last factorization done again (kRescaleGrowth; 0: none)
-  kKFreshSingular,  // 1: that factorization was singular too
   kKOrderSlots
 };
 
@@ -1385,10 +1360,71 @@ FESD_KKT_KERNEL void sparse_factor(int n, int nz, const int* irn, const int* icn
   double* scale = a + nz;
   const auto a_addr = reinterpret_cast<std::uintptr_t>(a);
   const int a_lo = static_cast<int>(a_addr & 0x7fffffffU), a_hi = static_cast<int>(a_addr >> 31);
-  const bool may_warm = kReuseScaling && n >= kWarmMinRows && cached && n >= kKScaleSlots &&
-                        keep[kKScaled] == 1 && keep[kKLa] == la && keep[kKAAddrLo] == a_lo &&
-                        keep[kKAAddrHi] == a_hi;
-  // Working memory of the fronts (scratch, reused between calls) and the factorization's results.
+  const bool warm = kReuseScaling && n >= kWarmMinRows && cached && n >= kKScaleSlots &&
+                    keep[kKScaled] == 1 && keep[kKLa] == la && keep[kKAAddrLo] == a_lo &&
+                    keep[kKAAddrHi] == a_hi;
+  if (!warm) std::fill_n(scale, n, 1.0);
+  {
+    std::vector<double>& rmax = ws.rmax;
+    rmax.resize(n);
+    // The pattern in IW: 0-based, -1 for out-of-range entries.
+    const int *prow = iw + kHeader, *pcol = prow + nz;
+    // Every triplet in range (the usual case): no per-entry test. The first sweep has scale = 1.
+    const bool all_valid = iw[kHEntries] == nz;
+    const auto sweep = [&]<bool kChecked, bool kFirst>() {
+      std::fill(rmax.begin(), rmax.end(), 0.0);
+      for (int e = 0; e < nz; ++e) {
+        const int i = prow[e], j = pcol[e];
+        if (kChecked && i < 0) continue;
+        const double v = kFirst ? std::abs(a[e]) : std::abs(a[e]) * scale[i] * scale[j];
+        rmax[i] = std::max(rmax[i], v);
+        rmax[j] = std::max(rmax[j], v);
+      }
+      for (int i = 0; i < n; ++i) scale[i] *= inverse_sqrt_pow2(rmax[i]);
+    };
+    if (warm) {
+      for (int k = 0; k < kWarmSweeps; ++k) {
+        if (all_valid)
+          sweep.template operator()<false, false>();
+        else
+          sweep.template operator()<true, false>();
+      }
+    } else if (all_valid) {
+      sweep.template operator()<false, true>();
+      sweep.template operator()<false, false>();
+      sweep.template operator()<false, false>();
+    } else {
+      sweep.template operator()<true, true>();
+      sweep.template operator()<true, false>();
+      sweep.template operator()<true, false>();
+    }
+  }
+  if (n >= kKScaleSlots) {
+    keep[kKScaled] = 1;
+    keep[kKLa] = la;
+    keep[kKAAddrLo] = a_lo;
+    keep[kKAAddrHi] = a_hi;
+  }
+
+  // Scaled values in the permuted lower triangle.
+  std::vector<double>& cval = ws.cval;
+  grow(cval, static_cast<std::size_t>(iw[kHEntries]));  // every entry is written below
+  double amax = 0.0;
+  {
+    const int *prow = iw + kHeader, *pcol = prow + nz;
+    for (int e = 0; e < nz; ++e) {
+      const int i = prow[e];
+      if (i < 0) continue;
+      const double v = a[e] * scale[i] * scale[pcol[e]];
+      amax = std::max(amax, std::abs(v));
+      cval[sym.slot[e]] = v;
+    }
+  }
+  const double tiny = (n >= kLargeKktRows ? kTinyRelLarge : kTinyRel) *
+                      std::max(amax, std::numeric_limits<double>::min());
+  const double u = std::clamp(pivtol, kMinPivtol, kMaxPivtol);
+
+  // Multifrontal factorization; children (smaller last columns) come before their parent.
   std::vector<int>&fidx = ws.fidx, &kind = ws.kind;
   std::vector<double>&w1 = ws.w1, &w2 = ws.w2;
   std::vector<int>& w_pos = ws.lp;
@@ -1408,264 +1444,165 @@ FESD_KKT_KERNEL void sparse_factor(int n, int nz, const int* irn, const int* icn
       stack_owner.pop_back();
     }
   };
+  stack_owner.clear();
+  for (int s = 0; s < ns; ++s) release(cb[s]);
   Index a_next = fixed_la, iw_next = fixed_liw;
   int negative = 0, rank = n, maxnf = 0, nfronts = 0;
   long long delayed = 0;
   bool singular = false;
-  // Pass 0 starts from the previous factorization's scaling when it may (may_warm). Pass 1
-  // factorizes again with the scaling from the identity (kRescaleGrowth) if pass 0's factor has
-  // more than kRescaleGrowth times the entries of the static fronts, or of the last factor of
-  // this structure that pass 1 gave if that had more (delayed pivots that the matrix itself
-  // causes, which a fresh scaling does not remove); or if pass 0 found the matrix singular, unless
-  // the last pass 1 of this structure found it singular too.
-  const Index static_entries = static_factor_entries(iw);
-  const bool has_slots = n >= kKOrderSlots;
-  const Index fresh_entries =
-      has_slots ? std::max<Index>(static_entries, keep[kKFreshEntries]) : static_entries;
-  bool rescaled = false;
-  for (int pass = 0;; ++pass) {
-    const bool warm = pass == 0 && may_warm;
-    if (!warm) std::fill_n(scale, n, 1.0);
+  for (int s = 0; s < ns; ++s) {
+    const int nown = cols_ptr[s + 1] - cols_ptr[s];
+    const int* srows = sym.frows + sym.fptr[s];
+    const int nf0 = sym.fptr[s + 1] - sym.fptr[s];
+    // Front order (original numbering): own columns, the children's delayed pivots (children in
+    // order), then the static front's other rows; a static position sp >= nown moves down by nd.
+    int nd = 0;
+    for (int p = cptr[s]; p < cptr[s + 1]; ++p) nd += cb[clist[p]].ndelayed;
+    const int nfs = nown + nd, nf = nf0 + nd;
+    fidx.resize(nf);
+    std::copy_n(srows, nown, fidx.begin());
     {
-      std::vector<double>& rmax = ws.rmax;
-      rmax.resize(n);
-      // The pattern in IW: 0-based, -1 for out-of-range entries.
-      const int *prow = iw + kHeader, *pcol = prow + nz;
-      // Every triplet in range (the usual case): no per-entry test. The first sweep has scale = 1.
-      const bool all_valid = iw[kHEntries] == nz;
-      const auto sweep = [&]<bool kChecked, bool kFirst>() {
-        std::fill(rmax.begin(), rmax.end(), 0.0);
-        for (int e = 0; e < nz; ++e) {
-          const int i = prow[e], j = pcol[e];
-          if (kChecked && i < 0) continue;
-          const double v = kFirst ? std::abs(a[e]) : std::abs(a[e]) * scale[i] * scale[j];
-          rmax[i] = std::max(rmax[i], v);
-          rmax[j] = std::max(rmax[j], v);
-        }
-        for (int i = 0; i < n; ++i) scale[i] *= inverse_sqrt_pow2(rmax[i]);
-      };
-      if (warm) {
-        for (int k = 0; k < kWarmSweeps; ++k) {
-          if (all_valid)
-            sweep.template operator()<false, false>();
-          else
-            sweep.template operator()<true, false>();
-        }
-      } else if (all_valid) {
-        sweep.template operator()<false, true>();
-        sweep.template operator()<false, false>();
-        sweep.template operator()<false, false>();
-      } else {
-        sweep.template operator()<true, true>();
-        sweep.template operator()<true, false>();
-        sweep.template operator()<true, false>();
-      }
-    }
-    if (n >= kKScaleSlots) {
-      keep[kKScaled] = 1;
-      keep[kKLa] = la;
-      keep[kKAAddrLo] = a_lo;
-      keep[kKAAddrHi] = a_hi;
-    }
-
-    // Scaled values in the permuted lower triangle.
-    std::vector<double>& cval = ws.cval;
-    grow(cval, static_cast<std::size_t>(iw[kHEntries]));  // every entry is written below
-    double amax = 0.0;
-    {
-      const int *prow = iw + kHeader, *pcol = prow + nz;
-      for (int e = 0; e < nz; ++e) {
-        const int i = prow[e];
-        if (i < 0) continue;
-        const double v = a[e] * scale[i] * scale[pcol[e]];
-        amax = std::max(amax, std::abs(v));
-        cval[sym.slot[e]] = v;
-      }
-    }
-    const double tiny = (n >= kLargeKktRows ? kTinyRelLarge : kTinyRel) *
-                        std::max(amax, std::numeric_limits<double>::min());
-    const double u = std::clamp(pivtol, kMinPivtol, kMaxPivtol);
-
-    // Multifrontal factorization; children (smaller last columns) come before their parent.
-    stack_owner.clear();
-    stack_top = 0;
-    for (int s = 0; s < ns; ++s) release(cb[s]);
-    a_next = fixed_la;
-    iw_next = fixed_liw;
-    negative = 0;
-    rank = n;
-    maxnf = 0;
-    nfronts = 0;
-    delayed = 0;
-    singular = false;
-    for (int s = 0; s < ns; ++s) {
-      const int nown = cols_ptr[s + 1] - cols_ptr[s];
-      const int* srows = sym.frows + sym.fptr[s];
-      const int nf0 = sym.fptr[s + 1] - sym.fptr[s];
-      // Front order (original numbering): own columns, the children's delayed pivots (children in
-      // order), then the static front's other rows; a static position sp >= nown moves down by nd.
-      int nd = 0;
-      for (int p = cptr[s]; p < cptr[s + 1]; ++p) nd += cb[clist[p]].ndelayed;
-      const int nfs = nown + nd, nf = nf0 + nd;
-      fidx.resize(nf);
-      std::copy_n(srows, nown, fidx.begin());
-      {
-        int at = nown;
-        for (int p = cptr[s]; p < cptr[s + 1]; ++p) {
-          const Contribution& ch = cb[clist[p]];
-          at = static_cast<int>(std::copy_n(ch.idx.begin(), ch.ndelayed, fidx.begin() + at) -
-                                fidx.begin());
-        }
-      }
-      std::copy(srows + nown, srows + nf0, fidx.begin() + nfs);
-      maxnf = std::max(maxnf, nf);
-      const int ld = front_ld(nf);
-      // Fronts alternate between two buffers: a front whose parent comes next leaves its
-      // contribution block in place, and the parent reads it from there (no copy).
-      std::vector<double>& front = ws.front[s & 1];
-      grow(front, static_cast<std::size_t>(ld) * nf);
-      double* fr = front.data();
-      zero_front(fr, nf);
-      const auto shifted = [nown, nd](int sp) { return sp >= nown ? sp + nd : sp; };
-      // The original entries: one flat scatter over the front's entries (column by column, the
-      // columns hold ~4 entries each, and the per-column loop cost more than the scatter).
-      if (nd == 0) {
-#pragma GCC unroll 4
-        for (int q = sym.qptr[s]; q < sym.qptr[s + 1]; ++q) fr[sym.aoff[q]] += cval[q];
-      } else {
-        const int ld0 = front_ld(nf0);
-        for (int q = sym.qptr[s]; q < sym.qptr[s + 1]; ++q) {
-          const int t = sym.aoff[q] / ld0, sp = sym.aoff[q] - t * ld0;
-          fr[static_cast<std::size_t>(t) * ld + shifted(sp)] += cval[q];
-        }
-      }
-      int delayed_at = nown;
+      int at = nown;
       for (int p = cptr[s]; p < cptr[s + 1]; ++p) {
-        Contribution& ch = cb[clist[p]];
-        const int m = ch.m, chd = ch.ndelayed;
-        const int* map = sym.emap + sym.eptr[p];
-        if (nd == 0) {
-          // No delayed pivots (chd = 0 too): the static map as it is, no triangle test. (Vector
-          // adds for runs of consecutive positions, precomputed: as many instructions, no faster.)
-          const double* col0 = ch.first_column(stack.data());
-          const std::ptrdiff_t packed = ch.packed();
-          std::ptrdiff_t at = 0, step = ch.step();
-          for (int jb = 0; jb < m; ++jb, at += step, step -= packed) {
-            const double* col = col0 + at;
-            double* fc = fr + static_cast<std::size_t>(map[jb]) * ld;
+        const Contribution& ch = cb[clist[p]];
+        at = static_cast<int>(std::copy_n(ch.idx.begin(), ch.ndelayed, fidx.begin() + at) -
+                              fidx.begin());
+      }
+    }
+    std::copy(srows + nown, srows + nf0, fidx.begin() + nfs);
+    maxnf = std::max(maxnf, nf);
+    const int ld = front_ld(nf);
+    // Fronts alternate between two buffers: a front whose parent comes next leaves its
+    // contribution block in place, and the parent reads it from there (no copy).
+    std::vector<double>& front = ws.front[s & 1];
+    grow(front, static_cast<std::size_t>(ld) * nf);
+    double* fr = front.data();
+    zero_front(fr, nf);
+    const auto shifted = [nown, nd](int sp) { return sp >= nown ? sp + nd : sp; };
+    // The original entries: one flat scatter over the front's entries (column by column, the
+    // columns hold ~4 entries each, and the per-column loop cost more than the scatter).
+    if (nd == 0) {
 #pragma GCC unroll 4
-            for (int ib = jb; ib < m; ++ib) fc[map[ib]] += col[ib];
-          }
-        } else {
-          // Positions of the child's rows in this front: its delayed pivots, then its static rows.
-          w_pos.resize(m);
-          for (int b = 0; b < chd; ++b) w_pos[b] = delayed_at + b;
-          for (int b = chd; b < m; ++b) w_pos[b] = shifted(map[b - chd]);
-          delayed_at += chd;
-          const int* lp = w_pos.data();
-          const double* col0 = ch.first_column(stack.data());
-          const std::ptrdiff_t packed = ch.packed();
-          std::ptrdiff_t at = 0, step = ch.step();
-          for (int jb = 0; jb < m; ++jb, at += step, step -= packed) {
-            const double* col = col0 + at;
-            const int pj = lp[jb];
-            if (jb < chd) {
-              for (int ib = jb; ib < m; ++ib) {
-                const int pi = lp[ib];
-                const auto to = pi >= pj ? static_cast<std::size_t>(pj) * ld + pi
-                                         : static_cast<std::size_t>(pi) * ld + pj;
-                fr[to] += col[ib];
-              }
-            } else {
-              double* fc = fr + static_cast<std::size_t>(pj) * ld;
+      for (int q = sym.qptr[s]; q < sym.qptr[s + 1]; ++q) fr[sym.aoff[q]] += cval[q];
+    } else {
+      const int ld0 = front_ld(nf0);
+      for (int q = sym.qptr[s]; q < sym.qptr[s + 1]; ++q) {
+        const int t = sym.aoff[q] / ld0, sp = sym.aoff[q] - t * ld0;
+        fr[static_cast<std::size_t>(t) * ld + shifted(sp)] += cval[q];
+      }
+    }
+    int delayed_at = nown;
+    for (int p = cptr[s]; p < cptr[s + 1]; ++p) {
+      Contribution& ch = cb[clist[p]];
+      const int m = ch.m, chd = ch.ndelayed;
+      const int* map = sym.emap + sym.eptr[p];
+      if (nd == 0) {
+        // No delayed pivots (chd = 0 too): the static map as it is, no triangle test. (Vector adds
+        // for runs of consecutive positions, precomputed: as many instructions, no faster.)
+        const double* col0 = ch.first_column(stack.data());
+        const std::ptrdiff_t packed = ch.packed();
+        std::ptrdiff_t at = 0, step = ch.step();
+        for (int jb = 0; jb < m; ++jb, at += step, step -= packed) {
+          const double* col = col0 + at;
+          double* fc = fr + static_cast<std::size_t>(map[jb]) * ld;
 #pragma GCC unroll 4
-              for (int ib = jb; ib < m; ++ib) fc[lp[ib]] += col[ib];
-            }
-          }
+          for (int ib = jb; ib < m; ++ib) fc[map[ib]] += col[ib];
         }
-        release(ch);
-      }
-      grow(kind, nf);
-      const PivotResult pr =
-          partial_ldlt(nf, nfs, front.data(), fidx.data(), kind.data(), u, tiny, w1, w2);
-      const int ne = pr.nelim;
-      negative += pr.negative;
-      if (pr.zero > 0) {
-        singular = true;
-        rank -= pr.zero;
-      }
-      // Record for the solve: L block in A, indices (original numbering) and pivot kinds in IW.
-      const Index a_need = static_cast<Index>(nf) * ne, iw_need = 4 + nf + ne;
-      if (a_next + a_need <= la && iw_next + iw_need <= liw) {
-        for (int j = 0; j < ne; ++j)
-          std::copy_n(fr + static_cast<std::size_t>(j) * ld, nf,
-                      a + a_next + static_cast<Index>(j) * nf);
-        int* rec = iw + iw_next;
-        rec[0] = nf;
-        rec[1] = ne;
-        rec[2] = static_cast<int>(a_next);
-        std::copy_n(fidx.data(), nf, rec + 3);
-        std::copy_n(kind.data(), ne, rec + 3 + nf);
-        rec[3 + nf + ne] = static_cast<int>(iw_next);
-      }
-      a_next += a_need;
-      iw_next += iw_need;
-      ++nfronts;
-      const int m = nf - ne;
-      delayed += nfs - ne;
-      if (m > 0) {
-        if (sparent[s] < 0) {
-          // Only delayed pivots remain at a root: zero to round-off.
-          singular = true;
-          rank -= m;
-        } else {
-          // The block's rows: the pivots delayed to the parent (indices kept), then the static
-          // front's rows below the fully summed ones (the parent's emap has their positions).
-          Contribution& out = cb[s];
-          out.idx.assign(fidx.begin() + ne, fidx.begin() + nfs);
-          out.ndelayed = nfs - ne;
-          out.m = m;
-          if (sparent[s] == s + 1) {  // in place (the next front uses the other buffer)
-            out.offset = -1;
-            out.block = fr + static_cast<std::size_t>(ne) * ld + ne;
-            out.ldb = ld;
+      } else {
+        // Positions of the child's rows in this front: its delayed pivots, then its static rows.
+        w_pos.resize(m);
+        for (int b = 0; b < chd; ++b) w_pos[b] = delayed_at + b;
+        for (int b = chd; b < m; ++b) w_pos[b] = shifted(map[b - chd]);
+        delayed_at += chd;
+        const int* lp = w_pos.data();
+        const double* col0 = ch.first_column(stack.data());
+        const std::ptrdiff_t packed = ch.packed();
+        std::ptrdiff_t at = 0, step = ch.step();
+        for (int jb = 0; jb < m; ++jb, at += step, step -= packed) {
+          const double* col = col0 + at;
+          const int pj = lp[jb];
+          if (jb < chd) {
+            for (int ib = jb; ib < m; ++ib) {
+              const int pi = lp[ib];
+              const auto to = pi >= pj ? static_cast<std::size_t>(pj) * ld + pi
+                                       : static_cast<std::size_t>(pi) * ld + pj;
+              fr[to] += col[ib];
+            }
           } else {
-            const Index size = static_cast<Index>(m) * (m + 1) / 2;
-            if (stack_top + size > static_cast<Index>(stack.size())) {
-              // Grown by half (reserve: exactly that capacity; resize alone would double it).
-              const auto len = static_cast<std::size_t>(
-                  std::max(stack_top + size, static_cast<Index>(stack.size() + stack.size() / 2)));
-              stack.reserve(len);
-              stack.resize(len);
-            }
-            out.offset = stack_top;
-            out.block = nullptr;
-            out.ldb = 0;
-            double* dst = stack.data() + stack_top;
-            for (int j = 0; j < m; ++j)  // lower triangle, packed
-              std::copy_n(fr + static_cast<std::size_t>(ne + j) * ld + ne + j, m - j,
-                          dst + packed_column(m, j));
-            stack_owner.push_back(s);
-            stack_top += size;
-            stack_peak = std::max(stack_peak, stack_top);
+            double* fc = fr + static_cast<std::size_t>(pj) * ld;
+#pragma GCC unroll 4
+            for (int ib = jb; ib < m; ++ib) fc[lp[ib]] += col[ib];
           }
         }
       }
+      release(ch);
     }
-    const bool grown = static_cast<double>(a_next - fixed_la) >
-                       kRescaleGrowth * static_cast<double>(fresh_entries);
-    if (kFreshScaling && warm &&
-        (grown || (singular && !(has_slots && keep[kKFreshSingular] == 1)))) {
-      if (stats != nullptr) ++stats->rescalings;
-      rescaled = true;
-      continue;
+    grow(kind, nf);
+    const PivotResult pr =
+        partial_ldlt(nf, nfs, front.data(), fidx.data(), kind.data(), u, tiny, w1, w2);
+    const int ne = pr.nelim;
+    negative += pr.negative;
+    if (pr.zero > 0) {
+      singular = true;
+      rank -= pr.zero;
     }
-    break;
-  }
-  if (rescaled && has_slots) {
-    keep[kKFreshEntries] =
-        static_cast<int>(std::min<Index>(a_next - fixed_la, std::numeric_limits<int>::max()));
-    keep[kKFreshSingular] = singular ? 1 : 0;
+    // Record for the solve: L block in A, indices (original numbering) and pivot kinds in IW.
+    const Index a_need = static_cast<Index>(nf) * ne, iw_need = 4 + nf + ne;
+    if (a_next + a_need <= la && iw_next + iw_need <= liw) {
+      for (int j = 0; j < ne; ++j)
+        std::copy_n(fr + static_cast<std::size_t>(j) * ld, nf,
+                    a + a_next + static_cast<Index>(j) * nf);
+      int* rec = iw + iw_next;
+      rec[0] = nf;
+      rec[1] = ne;
+      rec[2] = static_cast<int>(a_next);
+      std::copy_n(fidx.data(), nf, rec + 3);
+      std::copy_n(kind.data(), ne, rec + 3 + nf);
+      rec[3 + nf + ne] = static_cast<int>(iw_next);
+    }
+    a_next += a_need;
+    iw_next += iw_need;
+    ++nfronts;
+    const int m = nf - ne;
+    delayed += nfs - ne;
+    if (m > 0) {
+      if (sparent[s] < 0) {
+        // Only delayed pivots remain at a root: zero to round-off.
+        singular = true;
+        rank -= m;
+      } else {
+        // The block's rows: the pivots delayed to the parent (indices kept), then the static
+        // front's rows below the fully summed ones (the parent's emap has their positions).
+        Contribution& out = cb[s];
+        out.idx.assign(fidx.begin() + ne, fidx.begin() + nfs);
+        out.ndelayed = nfs - ne;
+        out.m = m;
+        if (sparent[s] == s + 1) {  // in place (the next front uses the other buffer)
+          out.offset = -1;
+          out.block = fr + static_cast<std::size_t>(ne) * ld + ne;
+          out.ldb = ld;
+        } else {
+          const Index size = static_cast<Index>(m) * (m + 1) / 2;
+          if (stack_top + size > static_cast<Index>(stack.size())) {
+            // Grown by half (reserve: exactly that capacity; resize alone would double it).
+            const auto len = static_cast<std::size_t>(
+                std::max(stack_top + size, static_cast<Index>(stack.size() + stack.size() / 2)));
+            stack.reserve(len);
+            stack.resize(len);
+          }
+          out.offset = stack_top;
+          out.block = nullptr;
+          out.ldb = 0;
+          double* dst = stack.data() + stack_top;
+          for (int j = 0; j < m; ++j)  // lower triangle, packed
+            std::copy_n(fr + static_cast<std::size_t>(ne + j) * ld + ne + j, m - j,
+                        dst + packed_column(m, j));
+          stack_owner.push_back(s);
+          stack_top += size;
+          stack_peak = std::max(stack_peak, stack_top);
+        }
+      }
+    }
   }
   // After an outlier (a delayed-pivot cascade), give the memory back once the stack is far
   // larger than this factorization needed.
@@ -1678,7 +1615,7 @@ FESD_KKT_KERNEL void sparse_factor(int n, int nz, const int* irn, const int* icn
     stats->last_n = n;
     stats->last_factor_entries = a_next - fixed_la;
     stats->scratch_bytes = ws.bytes();
-    stats->last_static_entries = static_entries;
+    stats->last_static_entries = static_factor_entries(iw);
   }
   if (a_next > la || iw_next > liw) {
     info[0] = a_next > la ? -4 : -3;
