@@ -229,6 +229,21 @@ enum class KktSolver {
 std::string_view to_string(KktSolver v);
 bool parse(std::string_view name, KktSolver& out);
 
+/// How fesd's sparse LDL' scales a KKT matrix before factorizing it (docs/kkt-solver.md,
+/// "Scaling"). Symmetric Ruiz sweeps with powers of two either way; they keep the inertia, and the
+/// choice changes round-off only.
+enum class KktScaling {
+  /// Matrices of at least 1000 rows start from the previous factorization's scaling and do one
+  /// sweep; smaller ones three sweeps from the identity (default).
+  Warm,
+  /// Three sweeps from the identity at every factorization: the scaling depends on the matrix
+  /// alone, not on the run's history; two sweeps more per factorization.
+  Fresh,
+};
+/// Problem-file key `kkt_scaling`: "warm", "fresh".
+std::string_view to_string(KktScaling v);
+bool parse(std::string_view name, KktScaling& out);
+
 /// IPOPT options (problem-file table [ipopt]). Any other IPOPT option can be passed by name.
 struct NlpOptions {
   double tol = 1e-12;            ///< `tol` > 0 (IPOPT's default 1e-8 cannot reach 1e-12 accuracy)
@@ -240,6 +255,9 @@ struct NlpOptions {
   /// with sparse_ldl and ma27_pivtol 0.01 (unless [ipopt] sets a larger one), then, if that
   /// fails too, with MUMPS; HomotopyRow::linear_solver names the runs.
   KktSolver kkt_solver = KktSolver::Auto;
+  /// `kkt_scaling`: the scaling of the sparse LDL' (kkt_solver auto or sparse_ldl; with mumps or
+  /// dense it is an error to ask for fresh). The MUMPS fallback does its own.
+  KktScaling kkt_scaling = KktScaling::Warm;
   /// Extra IPOPT options as (name, value) strings, e.g. {"mu_strategy", "monotone"}. A
   /// warm-started NLP (every NLP of a homotopy after the first) that fails is solved again with
   /// IPOPT's monotone mu strategy from mu_init 1e-4, unless `mu_strategy` is set here; once that

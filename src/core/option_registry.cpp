@@ -418,6 +418,9 @@ std::vector<Option> build() {
                                                "", between(0, 12)));
   o.push_back(scalar<&T::nlp, &N::kkt_solver>(kIpopt, "kkt_solver", kBoth,
                                               "linear solver of IPOPT's KKT systems", ""));
+  o.push_back(scalar<&T::nlp, &N::kkt_scaling>(
+      kIpopt, "kkt_scaling", kBoth,
+      "scaling of the sparse LDL' (warm: from the last factorization's)", ""));
   return o;
 }
 

@@ -120,6 +120,8 @@ std::span<const std::string_view> enum_names<OcpInitialization>();
 template <>
 std::span<const std::string_view> enum_names<KktSolver>();
 template <>
+std::span<const std::string_view> enum_names<KktScaling>();
+template <>
 std::span<const std::string_view> enum_names<StepSolver>();
 template <>
 std::span<const std::string_view> enum_names<HomotopyUpdateRule>();

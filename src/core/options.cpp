@@ -30,6 +30,7 @@ constexpr std::array<std::string_view, 6> kMpccMode{"scholtes_ineq",      "schol
 constexpr std::array<std::string_view, 2> kTerminalConstraint{"none", "ell_1"};
 constexpr std::array<std::string_view, 3> kOcpInitialization{"constant", "simulation", "external"};
 constexpr std::array<std::string_view, 4> kKktSolver{"auto", "sparse_ldl", "dense", "mumps"};
+constexpr std::array<std::string_view, 2> kKktScaling{"warm", "fresh"};
 constexpr std::array<std::string_view, 2> kStepSolver{"homotopy", "active_set"};
 constexpr std::array<std::string_view, 2> kDcsMode{"stewart", "step"};
 constexpr std::array<std::string_view, 2> kHomotopyUpdateRule{"linear", "superlinear"};
@@ -92,6 +93,10 @@ std::span<const std::string_view> enum_names<OcpInitialization>() {
 template <>
 std::span<const std::string_view> enum_names<KktSolver>() {
   return kKktSolver;
+}
+template <>
+std::span<const std::string_view> enum_names<KktScaling>() {
+  return kKktScaling;
 }
 template <>
 std::span<const std::string_view> enum_names<StepSolver>() {
@@ -175,6 +180,12 @@ std::string_view to_string(KktSolver v) {
 bool parse(std::string_view name, KktSolver& out) {
   return parse_from(kKktSolver, name, out);
 }
+std::string_view to_string(KktScaling v) {
+  return name_of(kKktScaling, v);
+}
+bool parse(std::string_view name, KktScaling& out) {
+  return parse_from(kKktScaling, name, out);
+}
 std::string_view to_string(StepSolver v) {
   return name_of(kStepSolver, v);
 }
@@ -238,7 +249,18 @@ std::vector<std::string> warnings(const HomotopyOptions& o) {
 }
 
 std::vector<std::string> validate(const NlpOptions& o) {
-  return registry::check(registry::Table::Ipopt, registry::target_of(o));
+  std::vector<std::string> e = registry::check(registry::Table::Ipopt, registry::target_of(o));
+  const bool user_linear_solver = std::any_of(
+      o.extra.begin(), o.extra.end(), [](const auto& kv) { return kv.first == "linear_solver"; });
+  if (o.kkt_scaling != KktScaling::Warm &&
+      (user_linear_solver || o.kkt_solver == KktSolver::Mumps || o.kkt_solver == KktSolver::Dense))
+    e.push_back(fmt::format(
+        "ipopt.kkt_scaling = {} applies to fesd's sparse LDL' (kkt_solver = auto or sparse_ldl), "
+        "not to {}",
+        to_string(o.kkt_scaling),
+        user_linear_solver ? std::string("an IPOPT linear_solver")
+                           : fmt::format("kkt_solver = {}", to_string(o.kkt_solver))));
+  return e;
 }
 
 std::vector<std::string> validate(const DiscretizationOptions& d, const HomotopyOptions& h,

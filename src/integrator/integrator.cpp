@@ -969,6 +969,7 @@ class Integrator {
     if (!mumps_) {
       NlpOptions o = options_.nlp;
       o.kkt_solver = KktSolver::Mumps;
+      o.kkt_scaling = KktScaling::Warm;  // MUMPS scales on its own
       mumps_ = nlp::make_solver(o);
     }
     return *mumps_;

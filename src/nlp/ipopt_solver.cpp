@@ -184,9 +184,12 @@ class BlockTnlp final : public Ipopt::TNLP {
 /// The KKT module's own entry points (kkt_module.h), found once its library is loaded.
 struct KktModule {
   void (*request_mode)(int) = nullptr;
+  void (*request_scaling)(int) = nullptr;
   void (*stats)(FesdKktStats*) = nullptr;
   std::string problem;  // why it is not loaded ("" once it is)
-  bool ok() const { return request_mode != nullptr && stats != nullptr; }
+  bool ok() const {
+    return request_mode != nullptr && request_scaling != nullptr && stats != nullptr;
+  }
 };
 
 /// Loads libfesd_kkt.so (next to libfesd.so) globally, so that IPOPT's loader, which opens
@@ -207,6 +210,7 @@ const KktModule& kkt_module() {
       return m;
     }
     m.request_mode = reinterpret_cast<void (*)(int)>(dlsym(handle, "fesd_kkt_request_mode"));
+    m.request_scaling = reinterpret_cast<void (*)(int)>(dlsym(handle, "fesd_kkt_request_scaling"));
     m.stats = reinterpret_cast<void (*)(FesdKktStats*)>(dlsym(handle, "fesd_kkt_stats"));
     if (!m.ok()) m.problem = path.string() + " is not fesd's KKT module (entry points missing)";
     return m;
@@ -296,6 +300,7 @@ struct IpoptSolver::Impl {
   // on the monotone retry: the next warm-started NLPs run monotone first (kWarmMuInit).
   bool warm_monotone = false;
   KktSolver kkt_solver = KktSolver::Auto;
+  KktScaling kkt_scaling = KktScaling::Warm;
   double tol = 0;    // the configured tol (NlpOptions::tol or [ipopt] extra)
   int max_iter = 0;  // the configured max_iter
 };
@@ -317,6 +322,7 @@ IpoptSolver::IpoptSolver(const NlpOptions& o) : impl_(std::make_unique<Impl>()) 
   impl_->user_linear_solver = user_sets(o, "linear_solver");
   impl_->user_mu_strategy = user_sets(o, "mu_strategy");
   impl_->kkt_solver = o.kkt_solver;
+  impl_->kkt_scaling = o.kkt_scaling;
   const bool needs_module =
       o.kkt_solver == KktSolver::SparseLdl || o.kkt_solver == KktSolver::Dense;
   if (needs_module && !impl_->user_linear_solver && !kkt_module().ok())
@@ -392,6 +398,7 @@ NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_star
     FesdKktStats before{};
     if (run_mode >= 0) {
       kkt_module().request_mode(run_mode);
+      kkt_module().request_scaling(impl_->kkt_scaling == KktScaling::Fresh ? 1 : 0);
       kkt_module().stats(&before);
     }
     Ipopt::SmartPtr<BlockTnlp> tnlp = new BlockTnlp(nlp, start, warm);
@@ -402,6 +409,7 @@ NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_star
       FesdKktStats after{};
       kkt_module().stats(&after);
       kkt_module().request_mode(FESD_KKT_AUTO);
+      kkt_module().request_scaling(0);
       r.factorizations = after.factorizations - before.factorizations;
       if (run_mode == FESD_KKT_DENSE) r.factorizations = 0;  // the dense path keeps no counters
     }

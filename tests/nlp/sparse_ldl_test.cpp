@@ -23,6 +23,7 @@ namespace {
 
 struct Module {
   void (*request_mode)(int) = nullptr;
+  void (*request_scaling)(int) = nullptr;
   void (*ma27id)(int*, double*) = nullptr;
   void (*ma27ad)(const int*, const int*, const int*, const int*, int*, const int*, int*, int*, int*,
                  int*, int*, double*, int*, double*) = nullptr;
@@ -39,6 +40,8 @@ const Module& module() {
     void* h = dlopen(FESD_KKT_MODULE, RTLD_NOW | RTLD_GLOBAL);
     if (h == nullptr) return r;
     r.request_mode = reinterpret_cast<decltype(r.request_mode)>(dlsym(h, "fesd_kkt_request_mode"));
+    r.request_scaling =
+        reinterpret_cast<decltype(r.request_scaling)>(dlsym(h, "fesd_kkt_request_scaling"));
     r.ma27id = reinterpret_cast<decltype(r.ma27id)>(dlsym(h, "ma27id_"));
     r.ma27ad = reinterpret_cast<decltype(r.ma27ad)>(dlsym(h, "ma27ad_"));
     r.ma27bd = reinterpret_cast<decltype(r.ma27bd)>(dlsym(h, "ma27bd_"));
@@ -117,6 +120,10 @@ class Ma27 {
     return info_[0];
   }
   int negative() const { return info_[14]; }
+  /// The scaling of the last factorization (A = [values | scaling | factor], sparse_ldl.cpp).
+  std::vector<double> scaling() const {
+    return {a_.begin() + t_.nz(), a_.begin() + t_.nz() + t_.n};
+  }
   int reallocations() const { return reallocations_; }
   void shrink_la(int la) {
     la_ = la;
@@ -269,6 +276,41 @@ TEST(SparseLdl, WarmStartedScalingOnLargeMatrices) {
     const Eigen::VectorXd x = solver.solve(b);
     EXPECT_LT(backward_error(values == &t ? K : K1, x, b), 1e-14);
   }
+}
+
+// kkt_scaling = fresh (fesd_kkt_request_scaling(1)): every factorization scales from the identity,
+// so the scaling depends on the matrix alone: a matrix factorized again after another one of its
+// structure is scaled as the first time, bit for bit. With the default warm scaling (one sweep
+// from the previous factorization's) it is not, which is what the fresh one removes.
+TEST(SparseLdl, FreshScalingDependsOnTheMatrixAlone) {
+  ASSERT_NE(module().request_scaling, nullptr);
+  std::mt19937 rng(61);
+  Triplets t = random_kkt(rng, 700, 500, 1e-4);
+  for (int i = 0; i < 700; ++i) t.add(i, i, 3.0);
+  ASSERT_GE(t.n, 1000);  // kWarmMinRows: smaller matrices are always scaled from the identity
+  Triplets scaled = t;
+  for (int e = 0; e < t.nz(); ++e)
+    scaled.val[e] *= std::pow(10.0, static_cast<double>((t.irn[e] + t.icn[e]) % 7));
+  const Eigen::MatrixXd K = t.dense();
+  const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(t.n, -1, 1);
+  // t's scaling after factorizing t, or t, scaled and t again.
+  const auto scaling = [&](bool fresh, bool again) {
+    module().request_scaling(fresh ? 1 : 0);
+    Ma27 solver(t, FESD_KKT_SPARSE);
+    EXPECT_EQ(solver.factor(t.val), 0);
+    if (again) {
+      EXPECT_EQ(solver.factor(scaled.val), 0);
+      EXPECT_EQ(solver.factor(t.val), 0);
+    }
+    module().request_scaling(0);
+    EXPECT_LT(backward_error(K, solver.solve(b), b), 1e-14);
+    return solver.scaling();
+  };
+  const std::vector<double> first = scaling(true, false);
+  EXPECT_EQ(scaling(true, true), first);
+  EXPECT_NE(scaling(false, true), first);  // measured: the warm sweep from scaled's differs
+  // The first factorization of a structure is scaled from the identity either way.
+  EXPECT_EQ(scaling(false, false), first);
 }
 
 long long delayed_pivots() {
@@ -627,6 +669,41 @@ TEST(SparseLdl, SlidingOcpGivesMumpsObjective) {
   EXPECT_LE(std::abs(ia - ib), ib / 10) << ia << " vs " << ib;
 }
 
+// kkt_scaling reaches the module: with fresh no factorization starts from the previous scaling,
+// with warm (default) those of at least 1000 rows do; the optimum is the same.
+TEST(SparseLdl, KktScalingOptionOnTheSlidingOcp) {
+  ASSERT_NE(module().stats, nullptr);
+  const fesd::Ocp ocp = fesd_bench::sliding_ocp_paper();
+  fesd::OcpOptions warm = fesd_bench::sliding_options(), fresh = warm;
+  fresh.nlp.kkt_scaling = fesd::KktScaling::Fresh;
+  const auto warm_scalings = [] {
+    FesdKktStats st{};
+    module().stats(&st);
+    return st.warm_scalings;
+  };
+  const long long w0 = warm_scalings();
+  const fesd::OcpResult a = fesd::solve(ocp, warm);
+  const long long w1 = warm_scalings();
+  const fesd::OcpResult b = fesd::solve(ocp, fresh);
+  const long long w2 = warm_scalings();
+  ASSERT_EQ(a.status, fesd::Status::Success) << a.message;
+  ASSERT_EQ(b.status, fesd::Status::Success) << b.message;
+  EXPECT_GT(w1 - w0, 0);
+  EXPECT_EQ(w2 - w1, 0);
+  EXPECT_NEAR(a.objective, b.objective, 1e-8 * std::abs(a.objective));
+  // Not with a solver that is not fesd's sparse LDL'.
+  fesd::OcpOptions mumps = fresh;
+  mumps.nlp.kkt_solver = fesd::KktSolver::Mumps;
+  try {
+    (void)fesd::solve(ocp, mumps);
+    ADD_FAILURE() << "kkt_scaling = fresh with MUMPS accepted";
+  } catch (const fesd::InvalidOption& e) {
+    EXPECT_NE(std::string(e.what()).find("ipopt.kkt_scaling = fresh applies to fesd's sparse LDL'"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(SparseLdl, KktSolverOptionNames) {
   fesd::KktSolver k{};
   for (const char* name : {"auto", "sparse_ldl", "dense", "mumps"}) {
@@ -634,6 +711,12 @@ TEST(SparseLdl, KktSolverOptionNames) {
     EXPECT_EQ(fesd::to_string(k), name);
   }
   EXPECT_FALSE(fesd::parse("ma27", k));
+  fesd::KktScaling s{};
+  for (const char* name : {"warm", "fresh"}) {
+    ASSERT_TRUE(fesd::parse(name, s)) << name;
+    EXPECT_EQ(fesd::to_string(s), name);
+  }
+  EXPECT_FALSE(fesd::parse("identity", s));
 }
 
 }  // namespace

@@ -23,6 +23,7 @@ constexpr int kStepsDense = 1;
 constexpr int kStepsSparse = 2;
 
 thread_local int requested_mode = FESD_KKT_AUTO;
+thread_local bool fresh_scaling = false;
 thread_local FesdKktStats stats{};
 
 /// Matrices kept for benchmarks (fesd_kkt_capture).
@@ -69,6 +70,10 @@ FESD_KKT_EXPORT void fesd_kkt_request_mode(int mode) {
   requested_mode = mode;
 }
 
+FESD_KKT_EXPORT void fesd_kkt_request_scaling(int fresh) {
+  fresh_scaling = fresh != 0;
+}
+
 FESD_KKT_EXPORT void fesd_kkt_stats(FesdKktStats* out) {
   *out = stats;
 }
@@ -102,8 +107,8 @@ FESD_KKT_EXPORT void ma27bd_(const int* n, const int* nz, const int* irn, const 
                              int* maxfrt, int*, int*, double* cntl, int* info) {
   if (*nsteps == kStepsSparse) maybe_capture(*n, *nz, irn, icn, a);
   if (*nsteps == kStepsSparse)
-    fesd::kkt::sparse_factor(*n, *nz, irn, icn, a, *la, iw, *liw, ikeep, maxfrt, cntl[0], info,
-                             &stats);
+    fesd::kkt::sparse_factor(*n, *nz, irn, icn, a, *la, iw, *liw, ikeep, maxfrt, cntl[0],
+                             !fresh_scaling, info, &stats);
   else
     fesd::kkt::dense_factor(n, nz, irn, icn, a, la, iw, liw, maxfrt, info);
 }

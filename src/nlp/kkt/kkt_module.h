@@ -19,6 +19,12 @@ enum FesdKktMode {
 
 void fesd_kkt_request_mode(int mode);
 
+/* How the sparse factorizations of this thread scale their matrices from now on: 0 (default)
+ * from the previous factorization's scaling for matrices of at least 1000 rows (one Ruiz sweep),
+ * 1 from the identity at every factorization (three sweeps; the factor then depends on the
+ * matrix alone). NlpOptions::kkt_scaling, docs/kkt-solver.md ("Scaling"). */
+void fesd_kkt_request_scaling(int fresh);
+
 /* Cumulative counters of this thread's ma27bd_ calls that ran the sparse factorization:
  * number of calls, thread CPU seconds in them, delayed pivots, re-orderings, the last matrix's
  * order and entries of the factor, and the per-thread scratch memory held after it (front
@@ -36,6 +42,7 @@ struct FesdKktStats {
   long long reorderings_undone;  /* of them, undone: the factor was not smaller */
   long long scratch_bytes;       /* the thread's scratch memory after the last factorization */
   long long last_static_entries; /* the last factor's entries without delayed pivots */
+  long long warm_scalings;       /* factorizations scaled from the previous one's scaling */
 };
 void fesd_kkt_stats(struct FesdKktStats* out);
 void fesd_kkt_reset_stats(void);

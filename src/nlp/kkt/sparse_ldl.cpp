@@ -1258,7 +1258,7 @@ Index build_symbolic(int n, int nz, const int* irn, const int* icn, const int* p
 // the clones round differently: same factor bit for bit.
 FESD_KKT_KERNEL void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int la,
                                    int* iw, int liw, int* ikeep, int* maxfrt, double pivtol,
-                                   int* info, FesdKktStats* stats) {
+                                   bool may_warm_scale, int* info, FesdKktStats* stats) {
   const double t0 = thread_seconds();
   std::fill_n(info, kInfo, 0);
   const Index fixed_la = static_cast<Index>(nz) + n;
@@ -1360,10 +1360,11 @@ FESD_KKT_KERNEL void sparse_factor(int n, int nz, const int* irn, const int* icn
   double* scale = a + nz;
   const auto a_addr = reinterpret_cast<std::uintptr_t>(a);
   const int a_lo = static_cast<int>(a_addr & 0x7fffffffU), a_hi = static_cast<int>(a_addr >> 31);
-  const bool warm = kReuseScaling && n >= kWarmMinRows && cached && n >= kKScaleSlots &&
-                    keep[kKScaled] == 1 && keep[kKLa] == la && keep[kKAAddrLo] == a_lo &&
-                    keep[kKAAddrHi] == a_hi;
+  const bool warm = kReuseScaling && may_warm_scale && n >= kWarmMinRows && cached &&
+                    n >= kKScaleSlots && keep[kKScaled] == 1 && keep[kKLa] == la &&
+                    keep[kKAAddrLo] == a_lo && keep[kKAAddrHi] == a_hi;
   if (!warm) std::fill_n(scale, n, 1.0);
+  if (warm && stats != nullptr) ++stats->warm_scalings;
   {
     std::vector<double>& rmax = ws.rmax;
     rmax.resize(n);
