@@ -21,8 +21,8 @@ void fesd_kkt_request_mode(int mode);
 
 /* How the sparse factorizations of this thread scale their matrices from now on: 0 (default)
  * from the previous factorization's scaling for matrices of at least 1000 rows (one Ruiz sweep),
- * 1 from the identity at every factorization (three sweeps; the factor then depends on the
- * matrix alone). NlpOptions::kkt_scaling, docs/kkt-solver.md ("Scaling"). */
+ * 1 from the identity at every factorization (three sweeps; the scaling then depends on the
+ * matrix alone). NlpOptions::kkt_scaling, docs/kkt-solver.md ("Choosing the scaling"). */
 void fesd_kkt_request_scaling(int fresh);
 
 /* Cumulative counters of this thread's ma27bd_ calls that ran the sparse factorization:

@@ -113,6 +113,9 @@ constexpr double kMaxPivtol = 0.5;
 /// homotopy path's co-dimension-2 exit of the periodic stick-slip
 /// (PeriodicStickSlipExit.BothContactsSlipWhenX1ReachesOne, sanitizer build; its KKT matrices
 /// have at most 424 rows, so they keep the three sweeps from the identity, bit for bit).
+/// kkt_scaling = fresh (fesd_kkt_request_scaling, may_warm_scale = false) scales every matrix from
+/// the identity: the warm scaling drifts over hundreds of factorizations on some problems
+/// (docs/kkt-solver.md, "Delayed-pivot cascades", "Choosing the scaling").
 constexpr bool kReuseScaling = true;
 constexpr int kWarmMinRows = 1000;
 constexpr int kWarmSweeps = 1;
