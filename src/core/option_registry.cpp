@@ -475,6 +475,11 @@ std::string list(std::span<const std::string_view> names, std::string_view last_
 
 }  // namespace
 
+bool user_sets(const NlpOptions& o, std::string_view name) {
+  return std::any_of(o.extra.begin(), o.extra.end(),
+                     [&](const auto& kv) { return kv.first == name; });
+}
+
 std::string_view to_string(Table t) {
   switch (t) {
     case Table::Simulation:

@@ -126,6 +126,9 @@ std::span<const std::string_view> enum_names<StepSolver>();
 template <>
 std::span<const std::string_view> enum_names<HomotopyUpdateRule>();
 
+/// Whether the caller passes IPOPT option `name` itself ([ipopt] / NlpOptions::extra).
+bool user_sets(const NlpOptions& o, std::string_view name);
+
 /// Every option, table by table.
 std::span<const Option> all();
 /// The tables of a problem kind, in reading order: [simulation] or [ocp], then [discretization],

@@ -250,8 +250,7 @@ std::vector<std::string> warnings(const HomotopyOptions& o) {
 
 std::vector<std::string> validate(const NlpOptions& o) {
   std::vector<std::string> e = registry::check(registry::Table::Ipopt, registry::target_of(o));
-  const bool user_linear_solver = std::any_of(
-      o.extra.begin(), o.extra.end(), [](const auto& kv) { return kv.first == "linear_solver"; });
+  const bool user_linear_solver = registry::user_sets(o, "linear_solver");
   if (o.kkt_scaling != KktScaling::Warm &&
       (user_linear_solver || o.kkt_solver == KktSolver::Mumps || o.kkt_solver == KktSolver::Dense))
     e.push_back(fmt::format(

@@ -2,6 +2,7 @@
 // Exceptions never cross IPOPT: evaluations return false on non-finite values and IPOPT cuts the
 // step; the status comes back in NlpResult.
 #include "nlp/ipopt_solver.hpp"
+#include "core/option_registry.hpp"
 #include "core/util.hpp"
 
 #include <dlfcn.h>
@@ -284,12 +285,6 @@ void set_option(Ipopt::IpoptApplication& app, const std::string& name, const std
     throw InvalidOption(fmt::format("ipopt.{} = '{}': IPOPT rejects this value", name, value));
 }
 
-/// Whether the caller passes IPOPT option `name` itself ([ipopt] / NlpOptions::extra).
-bool user_sets(const NlpOptions& o, std::string_view name) {
-  return std::any_of(o.extra.begin(), o.extra.end(),
-                     [&](const auto& kv) { return kv.first == name; });
-}
-
 }  // namespace
 
 struct IpoptSolver::Impl {
@@ -319,8 +314,8 @@ IpoptSolver::IpoptSolver(const NlpOptions& o) : impl_(std::make_unique<Impl>()) 
   // 1e-8: complementarity could never get below that. Bounds are kept exact.
   app.Options()->SetNumericValue("bound_relax_factor", 0.0);
   for (const auto& [name, value] : o.extra) set_option(app, name, value);
-  impl_->user_linear_solver = user_sets(o, "linear_solver");
-  impl_->user_mu_strategy = user_sets(o, "mu_strategy");
+  impl_->user_linear_solver = registry::user_sets(o, "linear_solver");
+  impl_->user_mu_strategy = registry::user_sets(o, "mu_strategy");
   impl_->kkt_solver = o.kkt_solver;
   impl_->kkt_scaling = o.kkt_scaling;
   const bool needs_module =
@@ -342,7 +337,8 @@ IpoptSolver::IpoptSolver(const NlpOptions& o) : impl_(std::make_unique<Impl>()) 
 IpoptSolver::~IpoptSolver() = default;
 
 std::vector<std::string> warnings(const NlpOptions& o) {
-  if (user_sets(o, "linear_solver") || o.kkt_solver != KktSolver::Auto || kkt_module().ok())
+  if (registry::user_sets(o, "linear_solver") || o.kkt_solver != KktSolver::Auto ||
+      kkt_module().ok())
     return {};
   return {fmt::format(
       "kkt_solver = auto: fesd's KKT module is not available ({}), so IPOPT solves every KKT "
