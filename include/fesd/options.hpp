@@ -174,11 +174,24 @@ struct HomotopyOptions {
   /// ignores it): an NLP that fails after a converged one at a point that violates the
   /// constraints (primal infeasibility > 1e-6, or failed evaluations) is discarded and the
   /// homotopy goes back to the converged NLP's point with half the logarithmic sigma step
-  /// (sigma = sqrt(sigma_good * sigma_failed)), then on to the failed sigma; at most this many
+  /// (sigma = sqrt(sigma_good * sigma_failed); a later retry from the same point takes half the
+  /// step to the last retry's sigma instead if that is larger, so no sigma is tried twice from
+  /// one point), then on to the failed sigma; at most this many
   /// times per homotopy (the retried NLPs and the smaller steps after them do not count towards
   /// N_homotopy). A failed NLP that ends feasible (e.g. at max_iter) is kept, and so is every
   /// failed NLP with 0: the homotopy goes on from its point, as nosnoc's does.
   int homotopy_retries = 4;
+  /// `homotopy_cold_restart` (optimal control): when an NLP fails at a point that violates the
+  /// constraints and no retry is left (homotopy_retries), solve that NLP again once, at the
+  /// schedule's sigma, from the initial guess instead of from the NLP before it, and go on from
+  /// there. It acts only after such a failure, where the homotopy would otherwise start the next
+  /// NLP from a point that violates the constraints (and usually end nlp_failed); a homotopy
+  /// without one is unchanged. The relaxed path of a loose first sigma can end where the
+  /// tighter NLPs have no feasible neighbour (nosnoc_py's temperature control and 3-D gearbox,
+  /// docs/nosnoc-examples.md rows 9 and 32); the cold start reaches the NLP's feasible set from
+  /// elsewhere, usually at another local minimizer (the summary says so). The row of the failed
+  /// NLP is marked `restarted`, the new one `cold_start`.
+  bool homotopy_cold_restart = true;
   /// `intermediate_tol` >= 0: IPOPT tol of the NLPs with sigma > 10 complementarity_tol (they
   /// only have to be good starting points for the next NLP); the later NLPs, and one that
   /// already meets complementarity_tol, are solved to ipopt.tol. 0: ipopt.tol for every NLP.

@@ -47,6 +47,13 @@ struct HomotopyRow {
   /// The NLP failed and its point was discarded: the homotopy went back to the last converged
   /// NLP and took a smaller sigma step (HomotopyOptions::homotopy_retries).
   bool retried = false;
+  /// The NLP failed at a point that violates the constraints, no retry was left, and its point was
+  /// discarded: the homotopy solved the same sigma again from the initial guess, the next row
+  /// (HomotopyOptions::homotopy_cold_restart).
+  bool restarted = false;
+  /// The NLP started from the initial guess instead of the NLP before it (the homotopy's cold
+  /// restart after the row before, marked `restarted`).
+  bool cold_start = false;
 };
 
 /// A detected switch: the active set changes at an element boundary.

@@ -148,6 +148,8 @@ py::dict homotopy_row(const fesd::HomotopyRow& r) {
   d["active_set_fixed"] = r.active_set_fixed;
   d["pinned_exits"] = r.pinned_exits;
   d["retried"] = r.retried;
+  d["restarted"] = r.restarted;
+  d["cold_start"] = r.cold_start;
   return d;
 }
 

@@ -31,6 +31,8 @@ std::string format_homotopy_row(const HomotopyRow& r) {
                              r.pinned_exits, r.pinned_exits == 1 ? "" : "s")
                : std::string("  (the last NLP again, active set fixed)");
   if (r.retried) row += "  (failed: retried from the last converged NLP, smaller sigma step)";
+  if (r.restarted) row += "  (failed: solved again from the initial guess, the next row)";
+  if (r.cold_start) row += "  (cold restart from the initial guess)";
   return row + "\n";
 }
 

@@ -805,6 +805,7 @@ class Integrator {
     // (homotopy_retries is an optimal-control option).
     HomotopyOptions h = hopt;
     h.homotopy_retries = 0;
+    h.homotopy_cold_restart = false;
     mpcc::HomotopyResult hr =
         sp.mpcc.solve_homotopy(solver(), h, {}, mpcc::kStepWarmMaxIter, early_finish(sp, h));
     account(hr, rows);

@@ -186,6 +186,7 @@ IntegratorResult integrate(const Pds& model, const Eigen::VectorXd& x0, double T
   // homotopy_retries is an optimal-control option: a failed step goes to the fallback solver.
   HomotopyOptions step_homotopy = options.homotopy;
   step_homotopy.homotopy_retries = 0;
+  step_homotopy.homotopy_cold_restart = false;
   for (int step = 0; step < N_sim; ++step) {
     mpcc.fix(in.s0, x);
     const StepGuess g = projected_euler(model, tab, iv.N_FE(), T_step, x, u, p);

@@ -143,7 +143,9 @@ json homotopy_row(const HomotopyRow& r) {
               {"factorizations", r.factorizations},
               {"active_set_fixed", r.active_set_fixed},
               {"pinned_exits", r.pinned_exits},
-              {"retried", r.retried}};
+              {"retried", r.retried},
+              {"restarted", r.restarted},
+              {"cold_start", r.cold_start}};
 }
 
 json homotopy(const std::vector<std::vector<HomotopyRow>>& steps) {

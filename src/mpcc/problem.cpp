@@ -5,6 +5,8 @@
 #include <cmath>
 #include <utility>
 
+#include <fmt/format.h>
+
 #include "fesd/error.hpp"
 
 namespace fesd::mpcc {
@@ -78,6 +80,17 @@ void append(HomotopyResult& to, const HomotopyResult& from) {
   append_discarded(to, from);
   to.comp_residual = from.comp_residual;
   to.last_nlp_status = from.last_nlp_status;
+}
+
+std::string cold_restart_warning(const HomotopyResult& h) {
+  for (const HomotopyRow& r : h.rows)
+    if (r.cold_start)
+      return fmt::format(
+          "the NLP at sigma = {:.3g} failed from the NLP before it (and after the retries), so "
+          "it was solved again from the initial guess (homotopy_cold_restart): the result is the "
+          "minimizer that start leads to, not a continuation of the first NLPs",
+          r.sigma);
+  return {};
 }
 
 void add_to_summary(const HomotopyResult& h, Summary& summary, std::vector<HomotopyRow>& rows) {
@@ -158,6 +171,11 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
   std::optional<nlp::Iterate> good;
   double sigma_good = 0;
   int retries = 0;
+  // The smallest sigma a retry from `good` took so far (0: none): a later retry from the same
+  // point steps to half the logarithm of the way to it, never to a sigma already tried.
+  double sigma_retried = 0;
+  // homotopy_cold_restart: taken (once per homotopy), and the next NLP is the cold one.
+  bool cold_restarted = false, cold_now = false;
   bool last_ok = false, eval_failed = false;
   bool tight_now = false;  // solve the next NLP with the configured tolerance
   const int max_steps = homotopy_length(o);
@@ -173,11 +191,13 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
     // complementarity_tol, and the last, use the configured tolerance.
     const bool loose = !tight_now && o.intermediate_tol > 0 &&
                        sigma > kTightSigmaFactor * o.complementarity_tol && sigma > o.sigma_N;
-    const nlp::NlpResult r =
-        solver.solve(nlp_, it_, /*warm_start=*/k > 0, loose ? o.intermediate_tol : 0.0,
-                     k > 0 ? warm_max_iter : 0);
+    const bool warm = k > 0 && !cold_now;
+    const nlp::NlpResult r = solver.solve(
+        nlp_, it_, /*warm_start=*/warm, loose ? o.intermediate_tol : 0.0, warm ? warm_max_iter : 0);
     res.comp_residual = comp_residual(it_.x.data(), residual_pairs_);
     record(res, r, k, sigma);
+    res.rows.back().cold_start = cold_now;
+    cold_now = false;
     sigma_ = sigma;
     last_ok = r.success;
     eval_failed = r.eval_error;
@@ -194,7 +214,23 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
       if (on_row) on_row(res.rows.back());
       ++retries;
       it_ = *good;
-      sigma = std::sqrt(sigma_good * sigma);
+      // (A retry that ended feasible but failed is kept, and the failed sigma after it would
+      // otherwise send the next retry to that same sigma again.)
+      sigma = std::sqrt(sigma_good * std::max(sigma, sigma_retried));
+      sigma_retried = sigma;
+      continue;
+    }
+    // No retry left (or none possible): once per homotopy, the same NLP at the schedule's sigma
+    // from the initial guess (homotopy_cold_restart), instead of going on from a point that
+    // violates the constraints.
+    if (!last_ok && unusable && k > 0 && o.homotopy_cold_restart && !cold_restarted) {
+      res.rows.back().restarted = true;
+      if (on_row) on_row(res.rows.back());
+      cold_restarted = cold_now = true;
+      it_ = nlp::Iterate{};
+      it_.x = nlp_.x_init;
+      good.reset();
+      sigma = target;
       continue;
     }
     if (on_row) on_row(res.rows.back());
@@ -202,6 +238,7 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
     if (last_ok && o.homotopy_retries > 0) {  // (no copy when nothing can be retried)
       good = it_;
       sigma_good = sigma;
+      sigma_retried = 0;
     }
     if (last_ok && res.comp_residual <= o.complementarity_tol) {
       if (!loose) break;

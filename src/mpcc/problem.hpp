@@ -54,6 +54,10 @@ void append(HomotopyResult& to, const HomotopyResult& from);
 /// kept, so a failed fixed-active-set NLP (residual 0 by construction) cannot pass for a success.
 void append_discarded(HomotopyResult& to, const HomotopyResult& from);
 
+/// The summary's warning for a homotopy that took its cold restart
+/// (HomotopyOptions::homotopy_cold_restart), naming the sigma; empty if it took none.
+std::string cold_restart_warning(const HomotopyResult& h);
+
 /// Adds a homotopy's (or re-solve's) rows to `rows` and its work (NLPs, iterations, evaluation
 /// and solver time) to `summary`: the bookkeeping of every front end.
 void add_to_summary(const HomotopyResult& h, Summary& summary, std::vector<HomotopyRow>& rows);

@@ -747,6 +747,8 @@ OcpResult solve_impl(const Ocp& user, const OcpOptions& options, const std::vect
   mpcc::HomotopyResult hr = mp.solve_homotopy(*solver, options.homotopy, options.on_homotopy_row,
                                               /*warm_max_iter=*/0, finish);
   account(hr);
+  if (std::string w = mpcc::cold_restart_warning(hr); !w.empty())
+    res.summary.warnings.push_back(std::move(w));
   // Sliding exits left early (docs/formulation.md): pin them and solve the last NLP once more;
   // if that fails, the unpinned solution stays. (Pinned already if the homotopy ended early.)
   if (hr.status == Status::Success && !finished_early && options.discretization.pin_sliding_exits &&

@@ -147,6 +147,8 @@ OcpResult solve(const PdsOcp& ocp, const OcpOptions& options) {
   const std::unique_ptr<nlp::NlpSolver> solver = nlp::make_solver(options.nlp);
   mpcc::HomotopyResult hr = mp.solve_homotopy(*solver, options.homotopy, options.on_homotopy_row);
   mpcc::add_to_summary(hr, res.summary, res.homotopy);
+  if (std::string w = mpcc::cold_restart_warning(hr); !w.empty())
+    res.summary.warnings.push_back(std::move(w));
   // The re-solve with the active set of every element fixed (PdsInterval::active_set_bounds):
   // complementarity then holds exactly; if it fails, the homotopy's solution stays.
   if (hr.status == Status::Success && options.discretization.use_fesd &&

@@ -354,11 +354,22 @@ TEST(NosnocFiles, FailedFixedActiveSetResolveKeepsTheResidual) {
 // worse, so J >= J* - (the relaxation's sigma-level slack); measured 12.125263 (3.7e-3 above).
 // Physical checks: w stays on the heating branch (never the push to cooling, which needs
 // y = 21), the clock meets |t(tau_k) - k T / N| <= 0.1 at every interval end and ends at 4.9,
-// the room is held at 16 with u = 3.2 from the fourth interval on.
+// the room is held at 16 with u = 3.2 from the fourth interval on. As written (sigma_0 = 10,
+// the script's) the relaxed path goes down the cooling branch, and the NLP at sigma = 1e-3 fails
+// from it after every retry: the answer comes from the homotopy's cold restart at sigma = 1e-3
+// (homotopy_cold_restart; without it the run ends nlp_failed, docs/nosnoc-examples.md row 9).
 TEST(NosnocFiles, TemperatureControlOcpCoolsToTheBoundAndHoldsIt) {
   const fesd::OcpProblem p = fesd::load_ocp_problem(example_path("temperature_control_ocp.toml"));
+  EXPECT_EQ(p.options.homotopy.sigma_0, 10.0);
   const fesd::OcpResult r = fesd::solve(p.ocp, p.options);
   ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+  int cold = 0;
+  for (const fesd::HomotopyRow& row : r.homotopy)
+    if (row.cold_start) {
+      ++cold;
+      EXPECT_NEAR(row.sigma, 1e-3, 1e-15);
+    }
+  EXPECT_EQ(cold, 1);
   const double t1 = 5.0 * std::log(19.5 / 15.5);
   const double J_star = 15.68 - 3.1 * t1;
   EXPECT_NEAR(J_star, 12.121596, 1e-6);

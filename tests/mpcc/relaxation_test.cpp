@@ -286,24 +286,29 @@ TEST(SolveAgain, ChangesBoundsForOneNlpAndKeepsThePointIfItFails) {
 /// infeasibility `inf_pr`).
 class FailingSolver : public fesd::nlp::NlpSolver {
  public:
-  explicit FailingSolver(std::vector<int> fail, double inf_pr = 1.0)
-      : fail_(std::move(fail)), inf_pr_(inf_pr) {}
+  /// The calls in `feasible` fail too, but report inf_pr 1e-9 (a failure that ends feasible,
+  /// e.g. at max_iter).
+  explicit FailingSolver(std::vector<int> fail, double inf_pr = 1.0, std::vector<int> feasible = {})
+      : fail_(std::move(fail)), feasible_(std::move(feasible)), inf_pr_(inf_pr) {}
   fesd::nlp::NlpResult solve(const fesd::nlp::BlockNlp& nlp, fesd::nlp::Iterate& start,
                              bool warm_start, double tol, int max_iter) override {
     starts.push_back(start.x);
+    warm.push_back(warm_start);
     const int call = calls_++;
-    if (std::find(fail_.begin(), fail_.end(), call) == fail_.end())
+    const bool feasible = std::find(feasible_.begin(), feasible_.end(), call) != feasible_.end();
+    if (!feasible && std::find(fail_.begin(), fail_.end(), call) == fail_.end())
       return inner_->solve(nlp, start, warm_start, tol, max_iter);
     std::fill(start.x.begin(), start.x.end(), 5.0);
     fesd::nlp::NlpResult r;
     r.status = "Infeasible_Problem_Detected";
-    r.inf_pr = inf_pr_;
+    r.inf_pr = feasible ? 1e-9 : inf_pr_;
     return r;
   }
   std::vector<std::vector<double>> starts;  ///< the primal start of every call
+  std::vector<bool> warm;                   ///< warm_start of every call
 
  private:
-  std::vector<int> fail_;
+  std::vector<int> fail_, feasible_;
   double inf_pr_ = 1.0;
   int calls_ = 0;
   std::unique_ptr<fesd::nlp::NlpSolver> inner_ = fesd::nlp::make_solver(fesd::NlpOptions{});
@@ -345,6 +350,7 @@ TEST(HomotopyRetries, FailedNlpIsSolvedAgainFromTheLastConvergedOne) {
   EXPECT_NEAR(p.at(p.y), 0.0, 1e-6);
 
   options.homotopy_retries = 0;
+  options.homotopy_cold_restart = false;
   TinyProblem q(1.0);
   FailingSolver plain({2});
   const auto res0 = q.problem.solve_homotopy(plain, options);
@@ -370,6 +376,7 @@ TEST(HomotopyRetries, AtMostTheConfiguredNumber) {
   fesd::HomotopyOptions options;
   options.sigma_0 = 1.0;
   options.homotopy_retries = 3;
+  options.homotopy_cold_restart = false;
   TinyProblem p(1.0);
   FailingSolver solver({1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19});
   const auto res = p.problem.solve_homotopy(solver, options);
@@ -388,6 +395,124 @@ TEST(HomotopyRetries, AtMostTheConfiguredNumber) {
   // after the last: those do not count towards N_homotopy.
   EXPECT_EQ(s.size(), 17u);
   EXPECT_NEAR(s.back(), 1e-12, 1e-24);
+}
+
+// A retry that fails but ends feasible (kept: the homotopy goes on from it to the failed sigma),
+// then the failed sigma fails again: the next retry halves the step to the retry's sigma, it does
+// not repeat it (sqrt(1e-2 * 1e-3) = 10^-2.5 once, then 10^-2.25).
+TEST(HomotopyRetries, NoRetryRepeatsASigmaTriedFromTheSamePoint) {
+  fesd::HomotopyOptions options;
+  options.sigma_0 = 0.1;
+  options.homotopy_retries = 4;
+  TinyProblem p(1.0);
+  FailingSolver solver({2, 4}, 1.0, /*feasible=*/{3});
+  const auto res = p.problem.solve_homotopy(solver, options);
+  ASSERT_EQ(res.status, fesd::Status::Success) << res.last_nlp_status;
+  const std::vector<double> s = sigmas(res);
+  ASSERT_GE(s.size(), 7u);
+  EXPECT_NEAR(s[2], 1e-3, 1e-18);
+  EXPECT_TRUE(res.rows[2].retried);
+  EXPECT_NEAR(s[3], std::pow(10.0, -2.5), 1e-17);  // fails feasible: kept
+  EXPECT_FALSE(res.rows[3].retried);
+  EXPECT_NEAR(s[4], 1e-3, 1e-18);  // from the kept point; fails
+  EXPECT_TRUE(res.rows[4].retried);
+  EXPECT_NEAR(s[5], std::pow(10.0, -2.25), 1e-17);
+  EXPECT_EQ(solver.starts[5][p.x], solver.starts[2][p.x]);  // from the point of sigma = 1e-2
+  EXPECT_NEAR(s[6], 1e-3, 1e-18);
+  EXPECT_NEAR(p.at(p.x), 1.0, 1e-6);
+  EXPECT_NEAR(p.at(p.y), 0.0, 1e-6);
+}
+
+// ---- homotopy_cold_restart --------------------------------------------------------------------
+
+// The third NLP (sigma = 1e-3) fails and no retry is allowed: the same NLP again, cold, from the
+// initial guess; the homotopy goes on from its point to the MPCC's solution (1, 0). Without the
+// option it goes on from the failed point.
+TEST(HomotopyColdRestart, FailedNlpIsSolvedAgainFromTheInitialGuess) {
+  fesd::HomotopyOptions options;
+  options.sigma_0 = 0.1;
+  options.homotopy_retries = 0;
+  ASSERT_TRUE(options.homotopy_cold_restart);  // the default
+  TinyProblem p(1.0);
+  FailingSolver solver({2});
+  const auto res = p.problem.solve_homotopy(solver, options);
+  ASSERT_EQ(res.status, fesd::Status::Success) << res.last_nlp_status;
+  const std::vector<double> s = sigmas(res);
+  ASSERT_GE(s.size(), 5u);
+  EXPECT_NEAR(s[2], 1e-3, 1e-18);
+  EXPECT_TRUE(res.rows[2].restarted);
+  EXPECT_FALSE(res.rows[2].retried);
+  EXPECT_NEAR(s[3], 1e-3, 1e-18);
+  EXPECT_TRUE(res.rows[3].cold_start);
+  EXPECT_FALSE(solver.warm[3]);
+  EXPECT_EQ(solver.starts[3][p.x], solver.starts[0][p.x]);  // the initial guess
+  EXPECT_EQ(solver.starts[3][p.y], solver.starts[0][p.y]);
+  EXPECT_TRUE(solver.warm[4]);  // and warm again after it
+  EXPECT_NEAR(s[4], 1e-4, 1e-19);
+  for (std::size_t k = 0; k < res.rows.size(); ++k) {
+    if (k != 3) {
+      EXPECT_FALSE(res.rows[k].cold_start) << "row " << k;
+    }
+    if (k != 2) {
+      EXPECT_FALSE(res.rows[k].restarted) << "row " << k;
+    }
+  }
+  EXPECT_NEAR(p.at(p.x), 1.0, 1e-6);
+  EXPECT_NEAR(p.at(p.y), 0.0, 1e-6);
+  EXPECT_NE(fesd::mpcc::cold_restart_warning(res).find("sigma = 0.001"), std::string::npos);
+
+  options.homotopy_cold_restart = false;
+  TinyProblem q(1.0);
+  FailingSolver plain({2});
+  const auto res0 = q.problem.solve_homotopy(plain, options);
+  ASSERT_GE(res0.rows.size(), 4u);
+  EXPECT_FALSE(res0.rows[2].restarted);
+  EXPECT_EQ(plain.starts[3][q.x], 5.0);  // on from the failed point
+  EXPECT_TRUE(fesd::mpcc::cold_restart_warning(res0).empty());
+
+  // A failure that ends feasible is kept, as by the retries: no cold restart.
+  options.homotopy_cold_restart = true;
+  TinyProblem f(1.0);
+  FailingSolver feasible({}, 1.0, /*feasible=*/{2});
+  const auto res_f = f.problem.solve_homotopy(feasible, options);
+  for (const fesd::HomotopyRow& r : res_f.rows) EXPECT_FALSE(r.cold_start || r.restarted);
+}
+
+// After the retries: the cold restart goes to the schedule's sigma (not the last retry's), and
+// it is taken once per homotopy.
+TEST(HomotopyColdRestart, AfterTheRetriesAtTheSchedulesSigmaOnce) {
+  fesd::HomotopyOptions options;
+  options.sigma_0 = 0.1;
+  options.homotopy_retries = 2;
+  TinyProblem p(1.0);
+  FailingSolver solver({2, 3, 4});
+  const auto res = p.problem.solve_homotopy(solver, options);
+  ASSERT_EQ(res.status, fesd::Status::Success) << res.last_nlp_status;
+  const std::vector<double> s = sigmas(res);
+  ASSERT_GE(s.size(), 6u);
+  EXPECT_TRUE(res.rows[2].retried);
+  EXPECT_TRUE(res.rows[3].retried);
+  EXPECT_NEAR(s[4], std::pow(10.0, -2.25), 1e-17);  // the last retry's sigma; fails
+  EXPECT_TRUE(res.rows[4].restarted);
+  EXPECT_NEAR(s[5], 1e-3, 1e-18);
+  EXPECT_TRUE(res.rows[5].cold_start);
+  EXPECT_EQ(solver.starts[5][p.x], solver.starts[0][p.x]);
+
+  // Every NLP after the first fails: one cold restart, then the homotopy goes on and fails.
+  TinyProblem q(1.0);
+  FailingSolver all({1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19});
+  options.homotopy_retries = 0;
+  const auto res_all = q.problem.solve_homotopy(all, options);
+  EXPECT_EQ(res_all.status, fesd::Status::NlpFailed);
+  int cold = 0, restarted = 0;
+  for (const fesd::HomotopyRow& r : res_all.rows) {
+    cold += r.cold_start ? 1 : 0;
+    restarted += r.restarted ? 1 : 0;
+  }
+  EXPECT_EQ(cold, 1);
+  EXPECT_EQ(restarted, 1);
+  EXPECT_TRUE(res_all.rows[1].restarted);
+  EXPECT_TRUE(res_all.rows[2].cold_start);
 }
 
 // ---- Example 3(a) through the integrator ------------------------------------------------------

@@ -449,12 +449,14 @@ TEST(SparseLdl, OrderingComputedAgainWhenFewerDiagonalsAreZeroUndoneIfNotSmaller
 }
 
 /// nosnoc_py's hopper OCP (examples/nosnoc/hopper_ocp.toml, 25567 KKT rows) cut to `nlps` NLPs of
-/// at most `max_iter` IPOPT iterations each, on the sparse LDL'.
+/// at most `max_iter` IPOPT iterations each, on the sparse LDL' (the NLPs cut by max_iter end
+/// infeasible: no retry, no cold restart).
 fesd::OcpProblem short_hopper_ocp(int nlps, int max_iter) {
   fesd::OcpProblem p =
       fesd::load_ocp_problem(std::string(FESD_SOURCE_DIR) + "/examples/nosnoc/hopper_ocp.toml");
   p.options.homotopy.max_homotopy_steps = nlps;
   p.options.homotopy.homotopy_retries = 0;
+  p.options.homotopy.homotopy_cold_restart = false;
   p.options.nlp.max_iter = max_iter;
   p.options.nlp.kkt_solver = fesd::KktSolver::SparseLdl;
   return p;
