@@ -171,8 +171,9 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
   std::optional<nlp::Iterate> good;
   double sigma_good = 0;
   int retries = 0;
-  // The smallest sigma a retry from `good` took so far (0: none): a later retry from the same
-  // point steps to half the logarithm of the way to it, never to a sigma already tried.
+  // The sigma of the last retry from `good` (0: none): a later retry from the same point takes
+  // half the logarithmic step to it when it lies above the failed sigma, so no sigma is tried
+  // twice from one point.
   double sigma_retried = 0;
   // homotopy_cold_restart: taken (once per homotopy), and the next NLP is the cold one.
   bool cold_restarted = false, cold_now = false;
