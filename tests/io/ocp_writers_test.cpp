@@ -76,6 +76,8 @@ fesd::OcpResult make_result() {
       fesd::HomotopyRow{0, 1.0, 0.5, 2.0, 1e-12, 7, "Solve_Succeeded", 0.001, 0.001, "mumps"},
       fesd::HomotopyRow{1, 0.1, 1e-10, 1.25, 2e-13, 3, "Solve_Succeeded", 0.002, 0.002, "mumps"}};
   r.homotopy[0].retried = true;
+  r.homotopy[0].restarted = true;
+  r.homotopy[1].cold_start = true;
   r.summary.homotopy_steps = 2;
   r.summary.nlp_iterations = 10;
   r.summary.n_variables = 100;
@@ -143,6 +145,10 @@ TEST(WriteOcpJson, KeysInOrderAndValues) {
   EXPECT_EQ(j["homotopy"][1]["nlp_status"], "Solve_Succeeded");
   EXPECT_EQ(j["homotopy"][0]["retried"], true);
   EXPECT_EQ(j["homotopy"][1]["retried"], false);
+  EXPECT_EQ(j["homotopy"][0]["restarted"], true);
+  EXPECT_EQ(j["homotopy"][1]["restarted"], false);
+  EXPECT_EQ(j["homotopy"][0]["cold_start"], false);
+  EXPECT_EQ(j["homotopy"][1]["cold_start"], true);
   const auto& stats = j["stats"];
   EXPECT_EQ(stats["homotopy_steps"], 2);
   EXPECT_EQ(stats["nlp_iterations"], 10);
@@ -201,3 +207,25 @@ TEST(WriteOcpPlot, SvgAndErrors) {
 }
 
 }  // namespace
+
+// The progress table says which NLP the cold restart discarded and which one started cold
+// (homotopy_cold_restart), and a plain row says neither.
+TEST(HomotopyRowText, MarksTheColdRestart) {
+  fesd::HomotopyRow failed;
+  failed.sigma = 1e-3;
+  failed.nlp_status = "Infeasible_Problem_Detected";
+  failed.restarted = true;
+  fesd::HomotopyRow cold;
+  cold.sigma = 1e-3;
+  cold.nlp_status = "Solve_Succeeded";
+  cold.cold_start = true;
+  fesd::HomotopyRow plain;
+  plain.nlp_status = "Solve_Succeeded";
+  EXPECT_NE(fesd::format_homotopy_row(failed).find("failed: solved again from the initial guess"),
+            std::string::npos);
+  EXPECT_NE(fesd::format_homotopy_row(cold).find("cold restart from the initial guess"),
+            std::string::npos);
+  const std::string p = fesd::format_homotopy_row(plain);
+  EXPECT_EQ(p.find("initial guess"), std::string::npos);
+  EXPECT_EQ(p.find("retried"), std::string::npos);
+}
