@@ -266,6 +266,11 @@ struct OcpOptions {
   /// Called after every NLP of the homotopy, the pinned re-solve included (the CLI prints
   /// format_homotopy_row() of it); the library itself never prints.
   HomotopyCallback on_homotopy_row;
+  /// Called from inside an NLP after an IPOPT iteration, at most every nlp_progress_every_s
+  /// seconds of wall time (0: after every iteration), so that a long NLP shows what it is doing
+  /// (the CLI prints format_nlp_progress() of it under the table, every 30 s); must not throw.
+  NlpProgressCallback on_nlp_progress;
+  double nlp_progress_every_s = 30;  ///< >= 0
 };
 
 /// Empty if valid, else one line per broken rule.

@@ -181,16 +181,16 @@ struct HomotopyOptions {
   /// N_homotopy). A failed NLP that ends feasible (e.g. at max_iter) is kept, and so is every
   /// failed NLP with 0: the homotopy goes on from its point, as nosnoc's does.
   int homotopy_retries = 4;
-  /// `homotopy_cold_restart` (optimal control): when an NLP fails at a point that violates the
-  /// constraints and no retry is left (homotopy_retries), solve that NLP again once, at the
-  /// schedule's sigma, from the initial guess instead of from the NLP before it, and go on from
-  /// there. It acts only after such a failure, where the homotopy would otherwise start the next
-  /// NLP from a point that violates the constraints (and usually end nlp_failed); a homotopy
-  /// without one is unchanged. The relaxed path of a loose first sigma can end where the
-  /// tighter NLPs have no feasible neighbour (nosnoc_py's temperature control and 3-D gearbox,
-  /// docs/nosnoc-examples.md rows 9 and 32); the cold start reaches the NLP's feasible set from
-  /// elsewhere, usually at another local minimizer (the summary says so). The row of the failed
-  /// NLP is marked `restarted`, the new one `cold_start`.
+  /// `homotopy_cold_restart` (optimal control): a homotopy that would end with a failed NLP, after
+  /// an NLP that failed at a point violating the constraints with no retry left
+  /// (homotopy_retries), starts again once at that NLP's sigma (the schedule's) from the initial
+  /// guess instead of the NLP before it, and goes on from there. Every homotopy that does not end
+  /// failed is unchanged (a failure it recovers from on the way included). The relaxed path of a
+  /// loose first sigma can end where the tighter NLPs have no feasible neighbour (nosnoc_py's
+  /// temperature control and 3-D gearbox, docs/nosnoc-examples.md rows 9 and 32); the cold start
+  /// reaches the NLP's feasible set from elsewhere, usually at another local minimizer (the
+  /// summary says so). The rows of the replaced path are marked `restarted`, the cold NLP
+  /// `cold_start`.
   bool homotopy_cold_restart = true;
   /// `intermediate_tol` >= 0: IPOPT tol of the NLPs with sigma > 10 complementarity_tol (they
   /// only have to be good starting points for the next NLP); the later NLPs, and one that

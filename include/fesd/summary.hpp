@@ -47,12 +47,12 @@ struct HomotopyRow {
   /// The NLP failed and its point was discarded: the homotopy went back to the last converged
   /// NLP and took a smaller sigma step (HomotopyOptions::homotopy_retries).
   bool retried = false;
-  /// The NLP failed at a point that violates the constraints, no retry was left, and its point was
-  /// discarded: the homotopy solved the same sigma again from the initial guess, the next row
-  /// (HomotopyOptions::homotopy_cold_restart).
+  /// Part of a path that ended with a failed NLP and was replaced by the cold restart
+  /// (HomotopyOptions::homotopy_cold_restart): from the first NLP that failed at a point violating
+  /// the constraints with no retry left, to the end of that path.
   bool restarted = false;
-  /// The NLP started from the initial guess instead of the NLP before it (the homotopy's cold
-  /// restart after the row before, marked `restarted`).
+  /// The NLP started from the initial guess instead of the NLP before it: the cold restart, at
+  /// the sigma of the first `restarted` row.
   bool cold_start = false;
 };
 
@@ -165,6 +165,18 @@ using StepCallback = std::function<void(const StepProgress&)>;
 /// Progress of a homotopy: one call per NLP solved (the OCP; re-solves included).
 using HomotopyCallback = std::function<void(const HomotopyRow&)>;
 
+/// Progress inside one NLP: IPOPT's iterate after an iteration (OcpOptions::on_nlp_progress).
+struct NlpProgress {
+  /// IPOPT iterations of this NLP so far; when the NLP is solved again from the same start (a
+  /// retry with another mu strategy or pivot tolerance, the MUMPS fallback) those of every run.
+  int iteration = 0;
+  int run = 1;  ///< 1: the first run of this NLP, 2, 3, ...: its retries
+  double objective = 0, inf_pr = 0, inf_du = 0, mu = 0;
+  double wall_s = 0;  ///< since the NLP started
+};
+/// Called from inside IPOPT; must not throw.
+using NlpProgressCallback = std::function<void(const NlpProgress&)>;
+
 /// "    t_s = 1.5   active regions {0,2} -> {0,1,2}\n"
 std::string format_switch(const SwitchEvent& s);
 /// The header line of the homotopy table ("   k     sigma       comp ...\n").
@@ -172,6 +184,10 @@ std::string homotopy_table_header();
 /// One row of the homotopy table, aligned with homotopy_table_header() (a pinned re-solve is
 /// marked as such).
 std::string format_homotopy_row(const HomotopyRow& r);
+/// "       ... IPOPT iteration 2500, objective 1.1810464e+01, inf_pr 1.8e-09, inf_du 3.1e-04,
+/// mu 1.0e-09, 300 s\n" (", run 2" after the iteration count for a retry): the line the CLI prints
+/// while a long NLP runs, under the row of the NLP before it.
+std::string format_nlp_progress(const NlpProgress& p);
 /// "  step   12/40  t = 0.3  NLPs  5  iter   45  comp 1.2e-12  success\n" ("  run 2  step ..."
 /// for a run of simulate())
 std::string format_step_progress(const StepProgress& p);

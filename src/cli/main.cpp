@@ -591,6 +591,10 @@ void show_progress(fesd::OcpOptions& o) {
   o.on_homotopy_row = [](const fesd::HomotopyRow& r) {
     std::cerr << fesd::format_homotopy_row(r) << std::flush;
   };
+  // A line every 30 s while an NLP runs (the hopper's and the gearboxes' take minutes).
+  o.on_nlp_progress = [](const fesd::NlpProgress& p) {
+    std::cerr << fesd::format_nlp_progress(p) << std::flush;
+  };
 }
 
 /// Loads the problem file with the overrides, checks the output paths (before a possibly long

@@ -31,9 +31,17 @@ std::string format_homotopy_row(const HomotopyRow& r) {
                              r.pinned_exits, r.pinned_exits == 1 ? "" : "s")
                : std::string("  (the last NLP again, active set fixed)");
   if (r.retried) row += "  (failed: retried from the last converged NLP, smaller sigma step)";
-  if (r.restarted) row += "  (failed: solved again from the initial guess, the next row)";
+  if (r.restarted) row += "  (failed path: replaced by the cold restart)";
   if (r.cold_start) row += "  (cold restart from the initial guess)";
   return row + "\n";
+}
+
+std::string format_nlp_progress(const NlpProgress& p) {
+  return fmt::format(
+      "       ... IPOPT iteration {}{}, objective {:.7e}, inf_pr {:.1e}, inf_du {:.1e}, mu {:.1e}, "
+      "{:.0f} s\n",
+      p.iteration, p.run > 1 ? fmt::format(", run {}", p.run) : std::string(), p.objective,
+      p.inf_pr, p.inf_du, p.mu, p.wall_s);
 }
 
 std::string format_step_progress(const StepProgress& p) {

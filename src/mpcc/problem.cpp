@@ -86,9 +86,9 @@ std::string cold_restart_warning(const HomotopyResult& h) {
   for (const HomotopyRow& r : h.rows)
     if (r.cold_start)
       return fmt::format(
-          "the NLP at sigma = {:.3g} failed from the NLP before it (and after the retries), so "
-          "it was solved again from the initial guess (homotopy_cold_restart): the result is the "
-          "minimizer that start leads to, not a continuation of the first NLPs",
+          "the homotopy ended failed after the NLP at sigma = {:.3g} had failed (after the "
+          "retries), so it started again there from the initial guess (homotopy_cold_restart): "
+          "the result is the minimizer that start leads to, not a continuation of the first NLPs",
           r.sigma);
   return {};
 }
@@ -175,7 +175,15 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
   // half the logarithmic step to it when it lies above the failed sigma, so no sigma is tried
   // twice from one point.
   double sigma_retried = 0;
-  // homotopy_cold_restart: taken (once per homotopy), and the next NLP is the cold one.
+  // homotopy_cold_restart: the first NLP that failed at a point violating the constraints with
+  // no retry left (its row, the schedule's sigma it was heading to, and the NLPs counted then);
+  // if the homotopy ends with a failed NLP, it starts again there from the initial guess, once.
+  struct ColdStart {
+    int row = -1;
+    double sigma = 0;
+    int scheduled = 0;
+  };
+  std::optional<ColdStart> cold;
   bool cold_restarted = false, cold_now = false;
   bool last_ok = false, eval_failed = false;
   bool tight_now = false;  // solve the next NLP with the configured tolerance
@@ -183,82 +191,94 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
   // NLPs at the schedule's sigma (not retried) count towards max_steps; the retried NLPs and the
   // smaller steps after them (at most 2 homotopy_retries) do not. One NLP more than max_steps if
   // the last one met the tolerance only loosely (below).
-  for (int scheduled = 0; scheduled < max_steps + (tight_now ? 1 : 0);) {
-    const int k = static_cast<int>(res.rows.size());
-    const bool on_schedule = sigma == target;
-    apply_sigma(*relaxation_, nlp_, it_, sigma);
-    // NLPs far from the end of the homotopy only need to be good starting points for the next
-    // one: with intermediate_tol they stop earlier. The NLPs with sigma near
-    // complementarity_tol, and the last, use the configured tolerance.
-    const bool loose = !tight_now && o.intermediate_tol > 0 &&
-                       sigma > kTightSigmaFactor * o.complementarity_tol && sigma > o.sigma_N;
-    const bool warm = k > 0 && !cold_now;
-    const nlp::NlpResult r = solver.solve(
-        nlp_, it_, /*warm_start=*/warm, loose ? o.intermediate_tol : 0.0, warm ? warm_max_iter : 0);
-    res.comp_residual = comp_residual(it_.x.data(), residual_pairs_);
-    record(res, r, k, sigma);
-    res.rows.back().cold_start = cold_now;
-    cold_now = false;
-    sigma_ = sigma;
-    last_ok = r.success;
-    eval_failed = r.eval_error;
-    // A failed NLP whose point still satisfies the constraints (e.g. at max_iter) is a feasible
-    // point of the relaxed problem, and the homotopy goes on from it; one that does not is no
-    // start for the next sigma.
-    const bool unusable = r.eval_error || !(r.inf_pr <= kFeasibleFailure);
-    // (Only after a sigma step: the tight re-solve at a loosely converged NLP's sigma has none
-    // to make smaller.)
-    if (!last_ok && unusable && good && sigma < sigma_good && retries < o.homotopy_retries) {
-      // Back to the last converged NLP's point, and a sigma step of half the logarithm
-      // (sigma_good * sqrt(sigma / sigma_good)) towards the same target.
-      res.rows.back().retried = true;
+  int scheduled = 0;
+  for (;;) {
+    for (; scheduled < max_steps + (tight_now ? 1 : 0);) {
+      const int k = static_cast<int>(res.rows.size());
+      const bool on_schedule = sigma == target;
+      apply_sigma(*relaxation_, nlp_, it_, sigma);
+      // NLPs far from the end of the homotopy only need to be good starting points for the next
+      // one: with intermediate_tol they stop earlier. The NLPs with sigma near
+      // complementarity_tol, and the last, use the configured tolerance.
+      const bool loose = !tight_now && o.intermediate_tol > 0 &&
+                         sigma > kTightSigmaFactor * o.complementarity_tol && sigma > o.sigma_N;
+      const bool warm = k > 0 && !cold_now;
+      const nlp::NlpResult r =
+          solver.solve(nlp_, it_, /*warm_start=*/warm, loose ? o.intermediate_tol : 0.0,
+                       warm ? warm_max_iter : 0);
+      res.comp_residual = comp_residual(it_.x.data(), residual_pairs_);
+      record(res, r, k, sigma);
+      res.rows.back().cold_start = cold_now;
+      cold_now = false;
+      sigma_ = sigma;
+      last_ok = r.success;
+      eval_failed = r.eval_error;
+      // A failed NLP whose point still satisfies the constraints (e.g. at max_iter) is a feasible
+      // point of the relaxed problem, and the homotopy goes on from it; one that does not is no
+      // start for the next sigma.
+      const bool unusable = r.eval_error || !(r.inf_pr <= kFeasibleFailure);
+      // (Only after a sigma step: the tight re-solve at a loosely converged NLP's sigma has none
+      // to make smaller.)
+      if (!last_ok && unusable && good && sigma < sigma_good && retries < o.homotopy_retries) {
+        // Back to the last converged NLP's point, and a sigma step of half the logarithm
+        // (sigma_good * sqrt(sigma / sigma_good)) towards the same target.
+        res.rows.back().retried = true;
+        if (on_row) on_row(res.rows.back());
+        ++retries;
+        it_ = *good;
+        // (A retry that ended feasible but failed is kept, and the failed sigma after it would
+        // otherwise send the next retry to that same sigma again.)
+        sigma = std::sqrt(sigma_good * std::max(sigma, sigma_retried));
+        sigma_retried = sigma;
+        continue;
+      }
+      // No retry left (or none possible): the homotopy goes on from the failed point, and where
+      // the cold restart would start if it ends failed.
+      if (!last_ok && unusable && k > 0 && !cold && !cold_restarted)
+        cold = ColdStart{k, target, scheduled};
       if (on_row) on_row(res.rows.back());
-      ++retries;
-      it_ = *good;
-      // (A retry that ended feasible but failed is kept, and the failed sigma after it would
-      // otherwise send the next retry to that same sigma again.)
-      sigma = std::sqrt(sigma_good * std::max(sigma, sigma_retried));
-      sigma_retried = sigma;
-      continue;
+      if (on_schedule) ++scheduled;
+      if (last_ok && o.homotopy_retries > 0) {  // (no copy when nothing can be retried)
+        good = it_;
+        sigma_good = sigma;
+        sigma_retried = 0;
+      }
+      if (last_ok && res.comp_residual <= o.complementarity_tol) {
+        if (!loose) break;
+        // Complementarity already met by a loosely solved NLP: solve it again at this sigma with
+        // the configured tolerance (warm; usually a few iterations) before stopping.
+        tight_now = true;
+        continue;
+      }
+      if (sigma <= o.sigma_N) break;  // sigma cannot get smaller: another NLP would repeat this one
+      if (last_ok && finish) {
+        next_row_ = static_cast<int>(res.rows.size());
+        if (finish(res)) {
+          res.status = Status::Success;
+          return res;
+        }
+      }
+      // After a smaller step that converged, the step to the target; after that, the schedule's.
+      if (sigma <= target) target = next_sigma(o, sigma);
+      sigma = target;
     }
-    // No retry left (or none possible): once per homotopy, the same NLP at the schedule's sigma
-    // from the initial guess (homotopy_cold_restart), instead of going on from a point that
-    // violates the constraints.
-    if (!last_ok && unusable && k > 0 && o.homotopy_cold_restart && !cold_restarted) {
-      res.rows.back().restarted = true;
-      if (on_row) on_row(res.rows.back());
+    // homotopy_cold_restart: a homotopy that would end with a failed NLP, after one that failed at
+    // a point violating the constraints with no retry left, solves that NLP's sigma again from the
+    // initial guess (without multipliers: IPOPT's cold start) and goes on from there, once. The
+    // rows from that failure on are marked `restarted`.
+    if (!last_ok && cold && o.homotopy_cold_restart && !cold_restarted) {
+      for (std::size_t i = static_cast<std::size_t>(cold->row); i < res.rows.size(); ++i)
+        res.rows[i].restarted = true;
       cold_restarted = cold_now = true;
       it_ = nlp::Iterate{};
       it_.x = nlp_.x_init;
       good.reset();
-      sigma = target;
+      sigma = target = cold->sigma;
+      scheduled = cold->scheduled;
+      tight_now = false;
       continue;
     }
-    if (on_row) on_row(res.rows.back());
-    if (on_schedule) ++scheduled;
-    if (last_ok && o.homotopy_retries > 0) {  // (no copy when nothing can be retried)
-      good = it_;
-      sigma_good = sigma;
-      sigma_retried = 0;
-    }
-    if (last_ok && res.comp_residual <= o.complementarity_tol) {
-      if (!loose) break;
-      // Complementarity already met by a loosely solved NLP: solve it again at this sigma with
-      // the configured tolerance (warm; usually a few iterations) before stopping.
-      tight_now = true;
-      continue;
-    }
-    if (sigma <= o.sigma_N) break;  // sigma cannot get smaller: another NLP would repeat this one
-    if (last_ok && finish) {
-      next_row_ = static_cast<int>(res.rows.size());
-      if (finish(res)) {
-        res.status = Status::Success;
-        return res;
-      }
-    }
-    // After a smaller step that converged, the step to the target; after that, the schedule's.
-    if (sigma <= target) target = next_sigma(o, sigma);
-    sigma = target;
+    break;
   }
   next_row_ = static_cast<int>(res.rows.size());
   res.status = final_status(last_ok, eval_failed, res.comp_residual, o.complementarity_tol);

@@ -75,9 +75,19 @@ std::string status_name(Ipopt::ApplicationReturnStatus s) {
   return "Unknown_Status";
 }
 
+/// Where a solve's progress goes (NlpSolver::set_progress), shared by the runs of one NLP.
+struct ProgressSink {
+  const NlpProgressCallback& callback;
+  double every_s = 0;
+  Clock::time_point start = Clock::now(), last = start;
+  int run = 0;                ///< 1-based, set per run
+  int iterations_before = 0;  ///< of the earlier runs
+};
+
 class BlockTnlp final : public Ipopt::TNLP {
  public:
-  BlockTnlp(const BlockNlp& nlp, Iterate& it, bool warm) : nlp_(nlp), it_(it), warm_(warm) {}
+  BlockTnlp(const BlockNlp& nlp, Iterate& it, bool warm, ProgressSink* progress)
+      : nlp_(nlp), it_(it), warm_(warm), progress_(progress) {}
 
   bool get_nlp_info(Ipopt::Index& n, Ipopt::Index& m, Ipopt::Index& nnz_jac, Ipopt::Index& nnz_h,
                     IndexStyleEnum& style) override {
@@ -148,14 +158,28 @@ class BlockTnlp final : public Ipopt::TNLP {
     it_.lambda.assign(lambda, lambda + m);
     objective_ = obj;
   }
-  bool intermediate_callback(Ipopt::AlgorithmMode, Ipopt::Index iter, Ipopt::Number,
-                             Ipopt::Number inf_pr, Ipopt::Number inf_du, Ipopt::Number,
+  bool intermediate_callback(Ipopt::AlgorithmMode, Ipopt::Index iter, Ipopt::Number obj,
+                             Ipopt::Number inf_pr, Ipopt::Number inf_du, Ipopt::Number mu,
                              Ipopt::Number, Ipopt::Number, Ipopt::Number, Ipopt::Number,
                              Ipopt::Index, const Ipopt::IpoptData*,
                              Ipopt::IpoptCalculatedQuantities*) override {
     iterations_ = iter;
     inf_pr_ = inf_pr;
     inf_du_ = inf_du;
+    if (progress_ != nullptr && progress_->callback) {
+      const auto now = Clock::now();
+      if (std::chrono::duration<double>(now - progress_->last).count() >= progress_->every_s) {
+        progress_->last = now;
+        progress_->callback(NlpProgress{
+            .iteration = progress_->iterations_before + iter,
+            .run = progress_->run,
+            .objective = obj,
+            .inf_pr = inf_pr,
+            .inf_du = inf_du,
+            .mu = mu,
+            .wall_s = std::chrono::duration<double>(now - progress_->start).count()});
+      }
+    }
     return true;
   }
 
@@ -178,6 +202,7 @@ class BlockTnlp final : public Ipopt::TNLP {
   const BlockNlp& nlp_;
   Iterate& it_;
   bool warm_;
+  ProgressSink* progress_;
   double eval_s_ = 0, objective_ = 0, inf_pr_ = 0, inf_du_ = 0;
   int eval_failures_ = 0, iterations_ = 0;
 };
@@ -388,6 +413,7 @@ NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_star
   const bool warm_retry = warm && !impl_->user_mu_strategy;
   const bool may_retry = mode == FESD_KKT_SPARSE || warm_retry;
   const Iterate start_copy = may_retry ? start : Iterate{};
+  ProgressSink progress{on_progress_, progress_every_s_};
   const auto run = [&](int run_mode) {
     if (!impl_->user_linear_solver)
       app.Options()->SetStringValue("linear_solver", run_mode >= 0 ? "ma27" : "mumps");
@@ -397,9 +423,11 @@ NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_star
       kkt_module().request_scaling(impl_->kkt_scaling == KktScaling::Fresh ? 1 : 0);
       kkt_module().stats(&before);
     }
-    Ipopt::SmartPtr<BlockTnlp> tnlp = new BlockTnlp(nlp, start, warm);
+    ++progress.run;
+    Ipopt::SmartPtr<BlockTnlp> tnlp = new BlockTnlp(nlp, start, warm, &progress);
     const Ipopt::ApplicationReturnStatus s =
         app.OptimizeTNLP(Ipopt::SmartPtr<Ipopt::TNLP>(Ipopt::GetRawPtr(tnlp)));
+    progress.iterations_before += tnlp->iterations();
     NlpResult r;
     if (run_mode >= 0) {
       FesdKktStats after{};

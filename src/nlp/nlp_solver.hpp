@@ -4,9 +4,11 @@
 #pragma once
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "fesd/options.hpp"
+#include "fesd/summary.hpp"
 #include "nlp/block_nlp.hpp"
 
 namespace fesd::nlp {
@@ -49,6 +51,16 @@ class NlpSolver {
   /// limit when it is lower; 0 keeps it.
   virtual NlpResult solve(const BlockNlp& nlp, Iterate& start, bool warm_start, double tol,
                           int max_iter) = 0;
+  /// From now on, each solve calls `on_progress` after an iteration at most every `every_s`
+  /// seconds of wall time (0: after every iteration); an empty callback: never (the default).
+  void set_progress(NlpProgressCallback on_progress, double every_s) {
+    on_progress_ = std::move(on_progress);
+    progress_every_s_ = every_s;
+  }
+
+ protected:
+  NlpProgressCallback on_progress_;
+  double progress_every_s_ = 0;
 };
 
 /// The NLP solver every front end uses: IPOPT with fesd's KKT module or MUMPS (kkt_solver).

@@ -703,7 +703,11 @@ std::string step_length_error(const OcpData& ocp) {
 }  // namespace ocp_detail
 
 std::vector<std::string> validate(const OcpOptions& o) {
-  return validate(o.discretization, o.homotopy, o.nlp);
+  std::vector<std::string> errors = validate(o.discretization, o.homotopy, o.nlp);
+  if (!(o.nlp_progress_every_s >= 0) || !std::isfinite(o.nlp_progress_every_s))
+    errors.push_back(fmt::format("nlp_progress_every_s = {}: must be a finite number >= 0",
+                                 o.nlp_progress_every_s));
+  return errors;
 }
 
 namespace {
@@ -741,6 +745,7 @@ OcpResult solve_impl(const Ocp& user, const OcpOptions& options, const std::vect
   res.summary.setup_s = seconds_since(t_start);
 
   const std::unique_ptr<nlp::NlpSolver> solver = nlp::make_solver(options.nlp);
+  solver->set_progress(options.on_nlp_progress, options.nlp_progress_every_s);
   ResolveAccount account{res.summary, res.homotopy};
   bool finished_early = false;
   const auto finish = early_active_set_finish(*b, options, *solver, res.summary, finished_early);

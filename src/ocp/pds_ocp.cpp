@@ -145,6 +145,7 @@ OcpResult solve(const PdsOcp& ocp, const OcpOptions& options) {
   res.summary.setup_s = seconds_since(t_start);
 
   const std::unique_ptr<nlp::NlpSolver> solver = nlp::make_solver(options.nlp);
+  solver->set_progress(options.on_nlp_progress, options.nlp_progress_every_s);
   mpcc::HomotopyResult hr = mp.solve_homotopy(*solver, options.homotopy, options.on_homotopy_row);
   mpcc::add_to_summary(hr, res.summary, res.homotopy);
   if (std::string w = mpcc::cold_restart_warning(hr); !w.empty())

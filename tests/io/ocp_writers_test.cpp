@@ -221,7 +221,7 @@ TEST(HomotopyRowText, MarksTheColdRestart) {
   cold.cold_start = true;
   fesd::HomotopyRow plain;
   plain.nlp_status = "Solve_Succeeded";
-  EXPECT_NE(fesd::format_homotopy_row(failed).find("failed: solved again from the initial guess"),
+  EXPECT_NE(fesd::format_homotopy_row(failed).find("failed path: replaced by the cold restart"),
             std::string::npos);
   EXPECT_NE(fesd::format_homotopy_row(cold).find("cold restart from the initial guess"),
             std::string::npos);

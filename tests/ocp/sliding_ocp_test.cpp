@@ -123,3 +123,43 @@ TEST(SlidingModeOcp, StableActiveSetEndsTheHomotopyEarly) {
 }
 
 }  // namespace
+
+// REAL SOLVES (about 1 s): OcpOptions::on_nlp_progress. With nlp_progress_every_s = 0 it is
+// called after every IPOPT iteration: once per iteration 0..n of each NLP, so the calls are the
+// homotopy's IPOPT iterations plus one per NLP (no NLP of this run is solved twice: each reports
+// run 1), counting up inside an NLP; with a long interval never; a negative one is refused.
+TEST(SlidingModeOcp, NlpProgressAfterEveryIterationOrNever) {
+  fesd::OcpProblem q = fesd::load_ocp_problem(std::string(FESD_SOURCE_DIR) +
+                                              "/examples/nosnoc/ocp_sliding_mode_nosnoc.toml");
+  std::vector<fesd::NlpProgress> calls;
+  q.options.on_nlp_progress = [&](const fesd::NlpProgress& p) { calls.push_back(p); };
+  q.options.nlp_progress_every_s = 0;
+  const fesd::OcpResult r = fesd::solve(q.ocp, q.options);
+  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+  for (const fesd::HomotopyRow& row : r.homotopy)
+    ASSERT_EQ(row.linear_solver.find("first run"), std::string::npos) << row.linear_solver;
+  EXPECT_EQ(calls.size(), static_cast<std::size_t>(r.summary.nlp_iterations) + r.homotopy.size());
+  int starts = 0;
+  for (std::size_t i = 0; i < calls.size(); ++i) {
+    EXPECT_EQ(calls[i].run, 1);
+    if (calls[i].iteration == 0) {
+      ++starts;
+    } else {
+      ASSERT_GT(i, 0u);
+      EXPECT_EQ(calls[i].iteration, calls[i - 1].iteration + 1) << "call " << i;
+    }
+    EXPECT_GE(calls[i].wall_s, 0.0);
+  }
+  EXPECT_EQ(starts, static_cast<int>(r.homotopy.size()));
+  EXPECT_EQ(calls.back().iteration, r.homotopy.back().nlp_iterations);
+
+  calls.clear();
+  q.options.nlp_progress_every_s = 1e9;
+  ASSERT_EQ(fesd::solve(q.ocp, q.options).status, fesd::Status::Success);
+  EXPECT_TRUE(calls.empty());
+
+  q.options.nlp_progress_every_s = -1;
+  const std::vector<std::string> errors = fesd::validate(q.options);
+  ASSERT_EQ(errors.size(), 1u);
+  EXPECT_NE(errors[0].find("nlp_progress_every_s"), std::string::npos);
+}
