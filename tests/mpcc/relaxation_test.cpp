@@ -368,6 +368,27 @@ TEST(HomotopyRetries, FailedNlpIsSolvedAgainFromTheLastConvergedOne) {
   ASSERT_GE(res_f.rows.size(), 4u);
   EXPECT_FALSE(res_f.rows[2].retried);
   EXPECT_NEAR(res_f.rows[3].sigma, 1e-4, 1e-19);
+
+  // A retry that fails but ends feasible is kept (the homotopy goes on from it to the failed
+  // sigma); when the failed sigma fails again, the next retry halves the step to the retry's
+  // sigma instead of repeating it (10^-2.5 once, then 10^-2.25).
+  TinyProblem r(1.0);
+  FailingSolver kept({2, 4}, 1.0, /*feasible=*/{3});
+  const auto res_k = r.problem.solve_homotopy(kept, options);
+  ASSERT_EQ(res_k.status, fesd::Status::Success) << res_k.last_nlp_status;
+  const std::vector<double> sk = sigmas(res_k);
+  ASSERT_GE(sk.size(), 7u);
+  EXPECT_NEAR(sk[2], 1e-3, 1e-18);
+  EXPECT_TRUE(res_k.rows[2].retried);
+  EXPECT_NEAR(sk[3], std::pow(10.0, -2.5), 1e-17);  // fails feasible: kept
+  EXPECT_FALSE(res_k.rows[3].retried);
+  EXPECT_NEAR(sk[4], 1e-3, 1e-18);  // from the kept point; fails
+  EXPECT_TRUE(res_k.rows[4].retried);
+  EXPECT_NEAR(sk[5], std::pow(10.0, -2.25), 1e-17);
+  EXPECT_EQ(kept.starts[5][r.x], kept.starts[2][r.x]);  // from the point of sigma = 1e-2
+  EXPECT_NEAR(sk[6], 1e-3, 1e-18);
+  EXPECT_NEAR(r.at(r.x), 1.0, 1e-6);
+  EXPECT_NEAR(r.at(r.y), 0.0, 1e-6);
 }
 
 // Every NLP after the first fails: at most homotopy_retries retries, each halving the logarithmic
@@ -397,33 +418,17 @@ TEST(HomotopyRetries, AtMostTheConfiguredNumber) {
   EXPECT_NEAR(s.back(), 1e-12, 1e-24);
 }
 
-// A retry that fails but ends feasible (kept: the homotopy goes on from it to the failed sigma),
-// then the failed sigma fails again: the next retry halves the step to the retry's sigma, it does
-// not repeat it (sqrt(1e-2 * 1e-3) = 10^-2.5 once, then 10^-2.25).
-TEST(HomotopyRetries, NoRetryRepeatsASigmaTriedFromTheSamePoint) {
+// ---- homotopy_cold_restart --------------------------------------------------------------------
+
+/// sigma = 0.1, 0.01, ... down to sigma_N, which is also complementarity_tol.
+fesd::HomotopyOptions homotopy_down_to(double sigma_N, int retries) {
   fesd::HomotopyOptions options;
   options.sigma_0 = 0.1;
-  options.homotopy_retries = 4;
-  TinyProblem p(1.0);
-  FailingSolver solver({2, 4}, 1.0, /*feasible=*/{3});
-  const auto res = p.problem.solve_homotopy(solver, options);
-  ASSERT_EQ(res.status, fesd::Status::Success) << res.last_nlp_status;
-  const std::vector<double> s = sigmas(res);
-  ASSERT_GE(s.size(), 7u);
-  EXPECT_NEAR(s[2], 1e-3, 1e-18);
-  EXPECT_TRUE(res.rows[2].retried);
-  EXPECT_NEAR(s[3], std::pow(10.0, -2.5), 1e-17);  // fails feasible: kept
-  EXPECT_FALSE(res.rows[3].retried);
-  EXPECT_NEAR(s[4], 1e-3, 1e-18);  // from the kept point; fails
-  EXPECT_TRUE(res.rows[4].retried);
-  EXPECT_NEAR(s[5], std::pow(10.0, -2.25), 1e-17);
-  EXPECT_EQ(solver.starts[5][p.x], solver.starts[2][p.x]);  // from the point of sigma = 1e-2
-  EXPECT_NEAR(s[6], 1e-3, 1e-18);
-  EXPECT_NEAR(p.at(p.x), 1.0, 1e-6);
-  EXPECT_NEAR(p.at(p.y), 0.0, 1e-6);
+  options.sigma_N = sigma_N;
+  options.complementarity_tol = sigma_N;
+  options.homotopy_retries = retries;
+  return options;
 }
-
-// ---- homotopy_cold_restart --------------------------------------------------------------------
 
 // sigma = 0.1, 0.01, 1e-3, 1e-4 (complementarity_tol 1e-4), no retries. The NLPs at 1e-3 and 1e-4
 // fail at points that violate the constraints, so the homotopy would end nlp_failed: it solves
@@ -431,11 +436,7 @@ TEST(HomotopyRetries, NoRetryRepeatsASigmaTriedFromTheSamePoint) {
 // (1, 0) relaxed by sigma = 1e-4. The rows from the first failure on are marked. Without the
 // option: nlp_failed.
 TEST(HomotopyColdRestart, FailedHomotopyStartsAgainFromTheInitialGuess) {
-  fesd::HomotopyOptions options;
-  options.sigma_0 = 0.1;
-  options.sigma_N = 1e-4;
-  options.complementarity_tol = 1e-4;
-  options.homotopy_retries = 0;
+  fesd::HomotopyOptions options = homotopy_down_to(1e-4, 0);
   ASSERT_TRUE(options.homotopy_cold_restart);  // the default
   TinyProblem p(1.0);
   FailingSolver solver({2, 3});
@@ -475,11 +476,7 @@ TEST(HomotopyColdRestart, FailedHomotopyStartsAgainFromTheInitialGuess) {
 // (nosnoc_py's discs, docs/nosnoc-examples.md row 22, go on from an NLP at inf_pr 5.5e-3 to a
 // better end than a cold start finds), and a failure that ends feasible.
 TEST(HomotopyColdRestart, OnlyWhenTheHomotopyEndsFailed) {
-  fesd::HomotopyOptions options;
-  options.sigma_0 = 0.1;
-  options.sigma_N = 1e-4;
-  options.complementarity_tol = 1e-4;
-  options.homotopy_retries = 0;
+  fesd::HomotopyOptions options = homotopy_down_to(1e-4, 0);
   TinyProblem p(1.0);
   FailingSolver recovers({2});
   const auto res = p.problem.solve_homotopy(recovers, options);
@@ -498,11 +495,7 @@ TEST(HomotopyColdRestart, OnlyWhenTheHomotopyEndsFailed) {
 // After the retries: the cold restart goes to the schedule's sigma the failed retry was heading
 // to (not the retry's), and it is taken once per homotopy.
 TEST(HomotopyColdRestart, AfterTheRetriesAtTheSchedulesSigmaOnce) {
-  fesd::HomotopyOptions options;
-  options.sigma_0 = 0.1;
-  options.sigma_N = 1e-3;
-  options.complementarity_tol = 1e-3;
-  options.homotopy_retries = 2;
+  fesd::HomotopyOptions options = homotopy_down_to(1e-3, 2);
   TinyProblem p(1.0);
   FailingSolver solver({2, 3, 4, 5});
   const auto res = p.problem.solve_homotopy(solver, options);
