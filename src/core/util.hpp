@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 #include <Eigen/Dense>
 
+#include "core/thread_clock.hpp"
 #include "fesd/error.hpp"
 
 namespace fesd::util {
@@ -19,13 +20,6 @@ using Clock = std::chrono::steady_clock;
 /// Wall seconds since t0.
 inline double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
-/// CPU seconds of the calling thread (CLOCK_THREAD_CPUTIME_ID).
-inline double thread_cpu_seconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
 /// first, first + 1, ..., first + n - 1.

@@ -40,9 +40,10 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <ctime>
 #include <limits>
 #include <vector>
+
+#include "core/thread_clock.hpp"
 
 namespace fesd::kkt {
 namespace {
@@ -1007,14 +1008,6 @@ double inverse_sqrt_pow2(double v) {
   return std::bit_cast<double>(static_cast<std::uint64_t>(1023 - half) << 52);
 }
 
-/// The calling thread's CPU time in seconds (the statistics' clock: on a shared machine wall time
-/// counted other processes' time slices).
-double thread_seconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
-
 }  // namespace
 
 void sparse_analyse(int n, int nz, const int* irn, const int* icn, int* ikeep, int* info,
@@ -1262,7 +1255,7 @@ Index build_symbolic(int n, int nz, const int* irn, const int* icn, const int* p
 FESD_KKT_KERNEL void sparse_factor(int n, int nz, const int* irn, const int* icn, double* a, int la,
                                    int* iw, int liw, int* ikeep, int* maxfrt, double pivtol,
                                    bool may_warm_scale, int* info, FesdKktStats* stats) {
-  const double t0 = thread_seconds();
+  const double t0 = util::thread_cpu_seconds();
   std::fill_n(info, kInfo, 0);
   const Index fixed_la = static_cast<Index>(nz) + n;
   const Index pattern_end = kHeader + 2 * static_cast<Index>(nz);
@@ -1638,14 +1631,14 @@ FESD_KKT_KERNEL void sparse_factor(int n, int nz, const int* irn, const int* icn
   }
   if (stats != nullptr) {
     ++stats->factorizations;
-    stats->factor_seconds += thread_seconds() - t0;
+    stats->factor_seconds += util::thread_cpu_seconds() - t0;
   }
 }
 
 void sparse_solve(int n, const double* a, const int* iw, double* w, double* rhs,
                   FesdKktStats* stats) {
   if (n == 0 || iw[kHMagic] != kMagic || iw[kHN] != n) return;
-  const double t0 = thread_seconds();
+  const double t0 = util::thread_cpu_seconds();
   const int nz = iw[kHNz];
   const int* irn = iw + kHeader;
   const int* icn = irn + nz;
@@ -1713,7 +1706,7 @@ void sparse_solve(int n, const double* a, const int* iw, double* w, double* rhs,
   }
   if (stats != nullptr) {
     ++stats->solves;
-    stats->solve_seconds += thread_seconds() - t0;
+    stats->solve_seconds += util::thread_cpu_seconds() - t0;
   }
 }
 
