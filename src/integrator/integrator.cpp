@@ -801,11 +801,8 @@ class Integrator {
 
   mpcc::HomotopyResult homotopy(StepProblem& sp, const HomotopyOptions& hopt,
                                 std::vector<HomotopyRow>& rows) {
-    // A failed step goes through the retry policy of step(), not through homotopy retries
-    // (homotopy_retries is an optimal-control option).
-    HomotopyOptions h = hopt;
-    h.homotopy_retries = 0;
-    h.homotopy_cold_restart = false;
+    // A failed step goes through the retry policy of step(), not through the OCP's rungs.
+    const HomotopyOptions h = mpcc::step_homotopy_options(hopt);
     mpcc::HomotopyResult hr =
         sp.mpcc.solve_homotopy(solver(), h, {}, mpcc::kStepWarmMaxIter, early_finish(sp, h));
     account(hr, rows);

@@ -183,10 +183,8 @@ IntegratorResult integrate(const Pds& model, const Eigen::VectorXd& x0, double T
   res.x.push_back(x0);
   Eigen::VectorXd x = x0;
   double t = 0;
-  // homotopy_retries is an optimal-control option: a failed step goes to the fallback solver.
-  HomotopyOptions step_homotopy = options.homotopy;
-  step_homotopy.homotopy_retries = 0;
-  step_homotopy.homotopy_cold_restart = false;
+  // A failed step goes to the fallback solver, not through the OCP's rungs.
+  const HomotopyOptions step_homotopy = mpcc::step_homotopy_options(options.homotopy);
   for (int step = 0; step < N_sim; ++step) {
     mpcc.fix(in.s0, x);
     const StepGuess g = projected_euler(model, tab, iv.N_FE(), T_step, x, u, p);

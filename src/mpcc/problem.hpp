@@ -54,6 +54,14 @@ void append(HomotopyResult& to, const HomotopyResult& from);
 /// kept, so a failed fixed-active-set NLP (residual 0 by construction) cannot pass for a success.
 void append_discarded(HomotopyResult& to, const HomotopyResult& from);
 
+/// `o` for one integration step: without the optimal-control rungs of a failed homotopy
+/// (homotopy_retries, homotopy_cold_restart); a failed step has the integrators' own retry policy.
+inline HomotopyOptions step_homotopy_options(HomotopyOptions o) {
+  o.homotopy_retries = 0;
+  o.homotopy_cold_restart = false;
+  return o;
+}
+
 /// The summary's warning for a homotopy that took its cold restart
 /// (HomotopyOptions::homotopy_cold_restart), naming the sigma; empty if it took none.
 std::string cold_restart_warning(const HomotopyResult& h);
