@@ -24,6 +24,7 @@
 
 #include "fesd/error.hpp"
 #include "nlp/kkt/kkt_module.h"
+#include "nlp/retry_ladder.hpp"
 
 namespace fesd::nlp {
 namespace {
@@ -170,14 +171,14 @@ class BlockTnlp final : public Ipopt::TNLP {
       const auto now = Clock::now();
       if (std::chrono::duration<double>(now - progress_->last).count() >= progress_->every_s) {
         progress_->last = now;
-        progress_->callback(NlpProgress{
-            .iteration = progress_->iterations_before + iter,
-            .run = progress_->run,
-            .objective = obj,
-            .inf_pr = inf_pr,
-            .inf_du = inf_du,
-            .mu = mu,
-            .wall_s = std::chrono::duration<double>(now - progress_->start).count()});
+        progress_->callback(
+            NlpProgress{.iteration = progress_->iterations_before + iter,
+                        .run = progress_->run,
+                        .objective = obj,
+                        .inf_pr = inf_pr,
+                        .inf_du = inf_du,
+                        .mu = mu,
+                        .wall_s = std::chrono::duration<double>(now - progress_->start).count()});
       }
     }
     return true;
@@ -244,7 +245,7 @@ const KktModule& kkt_module() {
   return module;
 }
 
-/// The second sparse_ldl run of an NLP whose first failed (IpoptSolver::solve): IPOPT's
+/// The stricter pivoting of a failed sparse_ldl NLP (RetryRung::StricterPivoting): IPOPT's
 /// ma27_pivtol (CNTL(1): a pivot is accepted if at least u times its column's largest entry) and
 /// the most IPOPT may raise it to. IPOPT's defaults are 1e-8 and 1e-4. Measured on
 /// examples/nosnoc/hopper_exercise_ocp_step.toml (docs/kkt-solver.md, "Retry, then fallback"):
@@ -261,9 +262,9 @@ constexpr double kRetryPivtolMax = 0.5;
 constexpr double kWarmMuInit = 1e-4;
 
 /// Whether a failed solve is worth repeating with another setting (IpoptSolver::solve: the
-/// monotone mu strategy, a stricter pivoting, MUMPS): not for the limits, the caller's stop and
-/// bad input, which no setting changes, nor for a detected infeasibility (the monotone run cured
-/// none of row 9's, docs/nosnoc-examples.md).
+/// monotone mu strategy, a fresh scaling, a stricter pivoting, MUMPS): not for the limits, the
+/// caller's stop and bad input, which no setting changes, nor for a detected infeasibility (the
+/// monotone run cured none of row 9's, docs/nosnoc-examples.md).
 bool worth_retrying(Ipopt::ApplicationReturnStatus s) {
   switch (s) {
     case Ipopt::Maximum_Iterations_Exceeded:
@@ -414,13 +415,14 @@ NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_star
   const bool may_retry = mode == FESD_KKT_SPARSE || warm_retry;
   const Iterate start_copy = may_retry ? start : Iterate{};
   ProgressSink progress{on_progress_, progress_every_s_};
+  bool fresh_scaling = impl_->kkt_scaling == KktScaling::Fresh;  // the retry may set it (below)
   const auto run = [&](int run_mode) {
     if (!impl_->user_linear_solver)
       app.Options()->SetStringValue("linear_solver", run_mode >= 0 ? "ma27" : "mumps");
     FesdKktStats before{};
     if (run_mode >= 0) {
       kkt_module().request_mode(run_mode);
-      kkt_module().request_scaling(impl_->kkt_scaling == KktScaling::Fresh ? 1 : 0);
+      kkt_module().request_scaling(fresh_scaling ? 1 : 0);
       kkt_module().stats(&before);
     }
     ++progress.run;
@@ -472,11 +474,9 @@ NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_star
   r.linear_solver =
       monotone_first ? fmt::format("{} ({}, as an NLP before needed)", name, monotone) : name;
   // A failed solve that another setting may cure (worth_retrying) is repeated from a copy of
-  // the same start, each run only if the one before failed too: a warm-started NLP with the other
-  // mu strategy (IPOPT's monotone one from kWarmMuInit, or after a monotone first run the
-  // adaptive one; not if [ipopt] sets mu_strategy); a sparse_ldl one with a stricter threshold
-  // pivoting (kRetryPivtol), then with MUMPS. The result names the failed runs in linear_solver
-  // and counts the iterations and evaluation time of every run.
+  // the same start with the settings of retry_ladder, each run only if the one before failed too
+  // (nlp/retry_ladder.hpp). The result names the failed runs in linear_solver and counts the
+  // iterations and evaluation time of every run.
   std::string tried =
       fmt::format("first run{}: {} after {} iterations",
                   monotone_first ? " (" + monotone + ")" : std::string(), r.status, r.iterations);
@@ -495,34 +495,50 @@ NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_star
       tried += fmt::format("; {}: {} after {} iterations", what, r.status,
                            r.iterations - failed.iterations);
   };
-  if (warm_retry && may_cure()) {
-    if (monotone_first) {
-      again(
-          mode, "again with mu_strategy " + mu_strategy, [] {}, [] {});
-      if (r.success) impl_->warm_monotone = false;  // this homotopy's NLPs no longer need it
-    } else {
-      again(mode, "again with " + monotone, set_monotone, reset_mu);
-      if (r.success) impl_->warm_monotone = true;
+  double pivtol = 1e-8, pivtolmax = 1e-4;  // IPOPT's defaults, unless set in [ipopt]
+  app.Options()->GetNumericValue("ma27_pivtol", pivtol, "");
+  app.Options()->GetNumericValue("ma27_pivtolmax", pivtolmax, "");
+  const std::vector<RetryRung> rungs = retry_ladder({.warm_retry = warm_retry,
+                                                     .sparse_ldl = mode == FESD_KKT_SPARSE,
+                                                     .fresh_scaling = fresh_scaling,
+                                                     .pivtol = pivtol,
+                                                     .retry_pivtol = kRetryPivtol});
+  for (const RetryRung rung : rungs) {
+    if (!may_cure()) break;
+    switch (rung) {
+      case RetryRung::OtherMuStrategy:
+        if (monotone_first) {
+          again(
+              mode, "again with mu_strategy " + mu_strategy, [] {}, [] {});
+          if (r.success) impl_->warm_monotone = false;  // this homotopy's NLPs no longer need it
+        } else {
+          again(mode, "again with " + monotone, set_monotone, reset_mu);
+          if (r.success) impl_->warm_monotone = true;
+        }
+        break;
+      case RetryRung::FreshScaling:
+        again(
+            mode, "again with kkt_scaling fresh", [&] { fresh_scaling = true; },
+            [&] { fresh_scaling = false; });
+        break;
+      case RetryRung::StricterPivoting:
+        again(
+            mode, fmt::format("again with ma27_pivtol {:g}", kRetryPivtol),
+            [&] {
+              app.Options()->SetNumericValue("ma27_pivtol", kRetryPivtol);
+              app.Options()->SetNumericValue("ma27_pivtolmax",
+                                             std::max(pivtolmax, kRetryPivtolMax));
+            },
+            [&] {
+              app.Options()->SetNumericValue("ma27_pivtol", pivtol);
+              app.Options()->SetNumericValue("ma27_pivtolmax", pivtolmax);
+            });
+        break;
+      case RetryRung::Mumps:
+        again(
+            -1, "sparse_ldl fallback", [] {}, [] {});
+        break;
     }
-  }
-  if (mode == FESD_KKT_SPARSE) {
-    double pivtol = 1e-8, pivtolmax = 1e-4;  // IPOPT's defaults, unless set in [ipopt]
-    app.Options()->GetNumericValue("ma27_pivtol", pivtol, "");
-    app.Options()->GetNumericValue("ma27_pivtolmax", pivtolmax, "");
-    if (pivtol < kRetryPivtol && may_cure())
-      again(
-          mode, fmt::format("again with ma27_pivtol {:g}", kRetryPivtol),
-          [&] {
-            app.Options()->SetNumericValue("ma27_pivtol", kRetryPivtol);
-            app.Options()->SetNumericValue("ma27_pivtolmax", std::max(pivtolmax, kRetryPivtolMax));
-          },
-          [&] {
-            app.Options()->SetNumericValue("ma27_pivtol", pivtol);
-            app.Options()->SetNumericValue("ma27_pivtolmax", pivtolmax);
-          });
-    if (may_cure())
-      again(
-          -1, "sparse_ldl fallback", [] {}, [] {});
   }
   r.total_s = seconds_since(t0);
   r.cpu_s = util::thread_cpu_seconds() - cpu0;

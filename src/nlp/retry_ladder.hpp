@@ -1,0 +1,38 @@
+// src/nlp/retry_ladder.hpp: the settings a failed NLP is solved again with (IpoptSolver::solve).
+//
+// A failed IPOPT solve that another setting may cure is repeated from a copy of the same start,
+// each run only if the one before failed too. The rungs, in order (docs/kkt-solver.md, "Retry,
+// then fallback"):
+//   OtherMuStrategy   a warm-started NLP whose mu strategy fesd chooses: IPOPT's monotone one
+//                     (or, after a monotone first run, the adaptive one);
+//   FreshScaling      on fesd's sparse LDL' with the warm-started scaling: the scaling from the
+//                     identity at every factorization (kkt_scaling = fresh);
+//   StricterPivoting  on the sparse LDL' below the retry's pivot tolerance: ma27_pivtol raised;
+//   Mumps             on the sparse LDL': IPOPT's MUMPS.
+#pragma once
+#include <vector>
+
+namespace fesd::nlp {
+
+enum class RetryRung { OtherMuStrategy, FreshScaling, StricterPivoting, Mumps };
+
+struct RetryLadderInput {
+  bool warm_retry = false;     ///< warm-started, and [ipopt] does not set mu_strategy
+  bool sparse_ldl = false;     ///< the first run factorizes with fesd's sparse LDL'
+  bool fresh_scaling = false;  ///< kkt_scaling = fresh already
+  double pivtol = 1e-8;        ///< the first run's ma27_pivtol
+  double retry_pivtol = 1e-2;  ///< the stricter pivoting's ma27_pivtol
+};
+
+/// The rungs to try, in order, after a failed first run.
+inline std::vector<RetryRung> retry_ladder(const RetryLadderInput& in) {
+  std::vector<RetryRung> rungs;
+  if (in.warm_retry) rungs.push_back(RetryRung::OtherMuStrategy);
+  if (!in.sparse_ldl) return rungs;
+  if (!in.fresh_scaling) rungs.push_back(RetryRung::FreshScaling);
+  if (in.pivtol < in.retry_pivtol) rungs.push_back(RetryRung::StricterPivoting);
+  rungs.push_back(RetryRung::Mumps);
+  return rungs;
+}
+
+}  // namespace fesd::nlp

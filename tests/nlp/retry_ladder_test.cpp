@@ -1,0 +1,42 @@
+// The settings a failed NLP is solved again with (src/nlp/retry_ladder.hpp), in order.
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "nlp/retry_ladder.hpp"
+
+namespace {
+
+using fesd::nlp::retry_ladder;
+using fesd::nlp::RetryLadderInput;
+using Rung = fesd::nlp::RetryRung;
+
+TEST(RetryLadder, SparseLdlTriesTheFreshScalingBeforeTheStricterPivoting) {
+  // A warm-started NLP on the sparse LDL' with fesd's defaults: every rung.
+  EXPECT_EQ(retry_ladder({.warm_retry = true, .sparse_ldl = true}),
+            (std::vector{Rung::OtherMuStrategy, Rung::FreshScaling, Rung::StricterPivoting,
+                         Rung::Mumps}));
+  // A cold NLP (the first of a homotopy): no other mu strategy.
+  EXPECT_EQ(retry_ladder({.sparse_ldl = true}),
+            (std::vector{Rung::FreshScaling, Rung::StricterPivoting, Rung::Mumps}));
+}
+
+TEST(RetryLadder, SkipsWhatTheFirstRunAlreadyHad) {
+  // kkt_scaling = fresh: no fresh-scaling run.
+  EXPECT_EQ(retry_ladder({.sparse_ldl = true, .fresh_scaling = true}),
+            (std::vector{Rung::StricterPivoting, Rung::Mumps}));
+  // [ipopt] ma27_pivtol at or above the retry's: no stricter pivoting.
+  EXPECT_EQ(retry_ladder({.sparse_ldl = true, .pivtol = 1e-2, .retry_pivtol = 1e-2}),
+            (std::vector{Rung::FreshScaling, Rung::Mumps}));
+  EXPECT_EQ(retry_ladder({.sparse_ldl = true, .pivtol = 0.5, .retry_pivtol = 1e-2}),
+            (std::vector{Rung::FreshScaling, Rung::Mumps}));
+}
+
+TEST(RetryLadder, OtherSolversOnlyChangeTheMuStrategy) {
+  // MUMPS, the dense LDL' or an [ipopt] linear_solver: no scaling, pivoting or fallback rungs.
+  EXPECT_EQ(retry_ladder({.warm_retry = true}), (std::vector{Rung::OtherMuStrategy}));
+  EXPECT_TRUE(retry_ladder({}).empty());
+  EXPECT_TRUE(retry_ladder({.fresh_scaling = true}).empty());
+}
+
+}  // namespace
