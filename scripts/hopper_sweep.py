@@ -12,13 +12,15 @@ the NLPs (the sum over the homotopy, as nosnoc_py's cpu_time_nlp). It prints one
 --csv writes them, each as soon as its point has finished (a point takes 10-40 min of CPU time),
 and --resume keeps the finished rows of that file and runs the other points (missing ones, and
 those that ended by --timeout or without a result: their rows are dropped), so a sweep can be
-run in pieces; --plot draws the scripts' two figures (CPU time, and CPU time per IPOPT
+run in pieces; --keep DIR keeps each point's problem file and JSON result (the homotopy's rows:
+which NLPs were retried and how); --plot draws the scripts' two figures (CPU time, and CPU time per IPOPT
 iteration, over n_s or N, step form against Stewart's). Nothing is written unless asked.
 
   python3 scripts/hopper_sweep.py ns --points 2,3 --csv /tmp/ns.csv --plot /tmp/ns.png
   python3 scripts/hopper_sweep.py ns --csv /tmp/ns.csv --resume      # the other points
 """
 import argparse
+import contextlib
 import csv
 import json
 import os
@@ -138,6 +140,9 @@ def main():
     a.add_argument("--resume", action="store_true",
                    help="keep the finished rows of --csv's file and run only the other points")
     a.add_argument("--plot", help="draw the scripts' two figures (PNG/SVG)")
+    a.add_argument("--keep", metavar="DIR",
+                   help="keep each point's problem file and JSON result in DIR (default: a "
+                        "temporary directory, removed at the end)")
     args = a.parse_args()
     key, points, flags, no_guess = EXPERIMENTS[args.experiment]
     if args.points:
@@ -179,7 +184,10 @@ def main():
         writer = csv.DictWriter(csv_file, fieldnames=FIELDS)
     print("%-8s %4s %-24s %12s %9s %5s %6s %9s %8s" % ("form", key[:4], "status", "objective",
           "comp", "NLPs", "iter", "CPU s", "s/iter"), flush=True)
-    with tempfile.TemporaryDirectory() as directory:
+    if args.keep:
+        pathlib.Path(args.keep).mkdir(parents=True, exist_ok=True)
+    with contextlib.nullcontext(args.keep) if args.keep else tempfile.TemporaryDirectory() \
+            as directory:
         for value in points:
             for form in forms:
                 if (form, value) in done:
