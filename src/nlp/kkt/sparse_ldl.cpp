@@ -700,11 +700,12 @@ FESD_KKT_KERNEL PivotResult partial_ldlt(int nf, int nfs, double* storage, int* 
     int pivot_p = -1, pivot_q = -1;
     bool zero_pivot = false;
     if (base < k) apply_pending(storage, k, base, k, ubuf, kind, ld, twos == 0);
+    // Column k's 1x1 test (the usual pivot); the search below repeats it after a failure, with
+    // this maximum (no later column's update changes column k, and row k left of it is empty).
+    const double colmax_k = abs_max(F.col(k), k + 1, ld);
     {
-      // Column k's 1x1 test (the usual pivot); the search below repeats it after a failure.
-      const double cmax = abs_max(F.col(k), k + 1, ld);
       const double akk = F.at(k, k);
-      if (std::abs(akk) > tiny && std::abs(akk) >= u * cmax) pivot_p = k;
+      if (std::abs(akk) > tiny && std::abs(akk) >= u * colmax_k) pivot_p = k;
     }
     if (pivot_p < 0 && base < k) {
       for (int j = k + 1; j < nfs; ++j)
@@ -717,7 +718,7 @@ FESD_KKT_KERNEL PivotResult partial_ldlt(int nf, int nfs, double* storage, int* 
       // serves the 2x2 search); the 2x2 partner only if the 1x1 test fails. Every maximum is
       // exact, so the pivots are those of one scalar loop over each row and column.
       const RowMax row = row_max(storage, lds, p, k);
-      const double colmax = abs_max(F.col(p), p + 1, ld);
+      const double colmax = p == k ? colmax_k : abs_max(F.col(p), p + 1, ld);
       const double cmax = std::max(colmax, row.max1);
       const double app = F.at(p, p);
       if (std::abs(app) > tiny && std::abs(app) >= u * cmax) {
