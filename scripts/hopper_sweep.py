@@ -12,8 +12,8 @@ the NLPs (the sum over the homotopy, as nosnoc_py's cpu_time_nlp). It prints one
 --csv writes them, each as soon as its point has finished (a point takes 10-40 min of CPU time),
 and --resume keeps the finished rows of that file and runs the other points (missing ones, and
 those that ended by --timeout or without a result: their rows are dropped), so a sweep can be
-run in pieces; --keep DIR keeps each point's problem file and JSON result (the homotopy's rows:
-which NLPs were retried and how); --plot draws the scripts' two figures (CPU time, and CPU time per IPOPT
+run in pieces; --keep DIR keeps each point's problem file, JSON result (the homotopy's rows:
+which NLPs were retried and how) and log (the report, and while it runs a progress line every 30 s); --plot draws the scripts' two figures (CPU time, and CPU time per IPOPT
 iteration, over n_s or N, step form against Stewart's). Nothing is written unless asked.
 
   python3 scripts/hopper_sweep.py ns --points 2,3 --csv /tmp/ns.csv --plot /tmp/ns.png
@@ -55,16 +55,19 @@ def variant(form, key, value, flags, no_guess, directory):
     return path
 
 
-def run_point(fesd, form, key, value, flags, no_guess, timeout, directory):
+def run_point(fesd, form, key, value, flags, no_guess, timeout, directory, keep):
     path = variant(form, key, value, flags, no_guess, directory)
     out = path.with_suffix(".json")
-    cmd = [fesd, "solve", str(path), "--json", str(out), "--quiet"]
+    # Kept points log the report and the progress lines (an NLP's IPOPT iteration every 30 s)
+    # as they come, so a long point can be followed with tail -f.
+    cmd = [fesd, "solve", str(path), "--json", str(out)] + ([] if keep else ["--quiet"])
     if key == "n_s":
         cmd += ["--n_s", str(value)]
     start = time.monotonic()
     try:
-        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
-        code = proc.returncode
+        with open(path.with_suffix(".log"), "w") if keep else open(os.devnull, "w") as log:
+            code = subprocess.run(cmd, stdout=log, stderr=subprocess.STDOUT,
+                                  timeout=timeout).returncode
     except subprocess.TimeoutExpired:
         code = None
     wall = time.monotonic() - start
@@ -141,8 +144,8 @@ def main():
                    help="keep the finished rows of --csv's file and run only the other points")
     a.add_argument("--plot", help="draw the scripts' two figures (PNG/SVG)")
     a.add_argument("--keep", metavar="DIR",
-                   help="keep each point's problem file and JSON result in DIR (default: a "
-                        "temporary directory, removed at the end)")
+                   help="keep each point's problem file, JSON result and log in DIR (default: "
+                        "a temporary directory, removed at the end)")
     args = a.parse_args()
     key, points, flags, no_guess = EXPERIMENTS[args.experiment]
     if args.points:
@@ -193,7 +196,7 @@ def main():
                 if (form, value) in done:
                     continue
                 r = run_point(args.fesd, form, key, value, flags, no_guess[form], args.timeout,
-                              directory)
+                              directory, bool(args.keep))
                 rows.append(r)
                 print("%-8s %4d %-24s %12s %9s %5s %6s %9s %8s" % (
                     form, value, r["status"], "%.6g" % r["objective"] if "objective" in r else "-",
