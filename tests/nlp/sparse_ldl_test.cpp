@@ -4,8 +4,11 @@
 // once; and OCP (61) solved with kkt_solver = sparse_ldl against MUMPS.
 #include <dlfcn.h>
 
+#include <link.h>
+
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <random>
 #include <string>
 #include <thread>
@@ -354,6 +357,24 @@ TEST(SparseLdl, DelayedPivotsChangingBetweenFactorizationsOfOneStructure) {
   EXPECT_GE(with_delays, 6);
 }
 
+/// The tests that solve through libfesd and read the module's counters here need the libfesd
+/// this process runs to be the build's: it loads the KKT module next to itself, and the counters
+/// read here are FESD_KKT_MODULE's. With LD_LIBRARY_PATH pointing at another build they would be
+/// two modules. "" if they are one, else what differs.
+std::string other_build() {
+  void* h = dlopen("libfesd.so.0", RTLD_NOW | RTLD_NOLOAD);
+  link_map* map = nullptr;
+  if (h == nullptr || dlinfo(h, RTLD_DI_LINKMAP, &map) != 0 || map == nullptr)
+    return "libfesd.so.0 is not loaded";
+  namespace fs = std::filesystem;
+  const fs::path lib = fs::canonical(map->l_name).parent_path();
+  const fs::path kkt = fs::canonical(FESD_KKT_MODULE).parent_path();
+  dlclose(h);
+  if (lib == kkt) return {};
+  return "this process runs " + lib.string() + "/libfesd.so.0, whose KKT module is not " +
+         FESD_KKT_MODULE + " (LD_LIBRARY_PATH points at another build: unset it)";
+}
+
 FesdKktStats kkt_stats() {
   FesdKktStats st{};
   module().stats(&st);
@@ -468,6 +489,7 @@ fesd::OcpProblem short_hopper_ocp(int nlps, int max_iter) {
 // 1.96e6 -> 1.35e6), which is kept. 15 IPOPT iterations per NLP are enough to get there.
 TEST(SparseLdl, HopperOcpKeepsTheOrderingOfItsPerturbedMatrices) {
   ASSERT_NE(module().stats, nullptr);
+  ASSERT_EQ(other_build(), "");
   const fesd::OcpProblem p = short_hopper_ocp(2, 15);
   const FesdKktStats before = kkt_stats();
   const fesd::OcpResult r = fesd::solve(p.ocp, p.options);
@@ -489,6 +511,7 @@ TEST(SparseLdl, HopperOcpKeepsTheOrderingOfItsPerturbedMatrices) {
 // until the end of a factorization would still pass: 9.6 MB, measured in review.)
 TEST(SparseLdl, ScratchMemoryIsAFractionOfTheFactorOnTheHopperOcp) {
   ASSERT_NE(module().stats, nullptr);
+  ASSERT_EQ(other_build(), "");
   const fesd::OcpProblem p = short_hopper_ocp(3, 20);
   FesdKktStats after{};
   // A thread of its own: the scratch memory is per thread, this one starts with none.
@@ -675,6 +698,7 @@ TEST(SparseLdl, SlidingOcpGivesMumpsObjective) {
 // with warm (default) those of at least 1000 rows do; the optimum is the same.
 TEST(SparseLdl, KktScalingOptionOnTheSlidingOcp) {
   ASSERT_NE(module().stats, nullptr);
+  ASSERT_EQ(other_build(), "");
   const fesd::Ocp ocp = fesd_bench::sliding_ocp_paper();
   fesd::OcpOptions warm = fesd_bench::sliding_options(), fresh = warm;
   fresh.nlp.kkt_scaling = fesd::KktScaling::Fresh;
