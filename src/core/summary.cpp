@@ -32,7 +32,12 @@ std::string format_homotopy_row(const HomotopyRow& r) {
                : std::string("  (the last NLP again, active set fixed)");
   if (r.retried) row += "  (failed: retried from the last converged NLP, smaller sigma step)";
   if (r.restarted) row += "  (failed path: replaced by the cold restart)";
-  if (r.cold_start) row += "  (cold restart from the initial guess)";
+  // (The live table has printed the replaced rows before the restart was known: this row says
+  // which they are.)
+  if (r.cold_start)
+    row +=
+        "  (cold restart from the initial guess; replaces the rows from the first failure without "
+        "a retry left)";
   return row + "\n";
 }
 
