@@ -13,8 +13,9 @@ the NLPs (the sum over the homotopy, as nosnoc_py's cpu_time_nlp). It prints one
 and --resume keeps the finished rows of that file and runs the other points (missing ones, and
 those that ended by --timeout or without a result: their rows are dropped), so a sweep can be
 run in pieces; --keep DIR keeps each point's problem file, JSON result (the homotopy's rows:
-which NLPs were retried and how) and log (the report, and while it runs a progress line every 30 s); --plot draws the scripts' two figures (CPU time, and CPU time per IPOPT
-iteration, over n_s or N, step form against Stewart's). Nothing is written unless asked.
+which NLPs were retried and how) and log (the report, and while it runs a progress line every
+30 s); --plot draws the scripts' two figures (CPU time, and CPU time per IPOPT iteration, over
+n_s or N, step form against Stewart's). Nothing is written unless asked.
 
   python3 scripts/hopper_sweep.py ns --points 2,3 --csv /tmp/ns.csv --plot /tmp/ns.png
   python3 scripts/hopper_sweep.py ns --csv /tmp/ns.csv --resume      # the other points
