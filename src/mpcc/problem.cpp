@@ -233,9 +233,9 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
         continue;
       }
       // No retry left (or none possible): the homotopy goes on from the failed point, and where
-      // the cold restart would start if it ends failed.
-      if (!last_ok && unusable && k > 0 && !cold && !cold_restarted)
-        cold = ColdStart{k, target, scheduled};
+      // the cold restart would start if it ends failed (the first such NLP: `cold` stays set
+      // after the restart too).
+      if (!last_ok && unusable && k > 0 && !cold) cold = ColdStart{k, target, scheduled};
       if (on_row) on_row(res.rows.back());
       if (on_schedule) ++scheduled;
       if (last_ok && o.homotopy_retries > 0) {  // (no copy when nothing can be retried)
