@@ -15,10 +15,13 @@ those that ended by --timeout or without a result: their rows are dropped), so a
 run in pieces; --keep DIR keeps each point's problem file, JSON result (the homotopy's rows:
 which NLPs were retried and how) and log (the report, and while it runs a progress line every
 30 s); --plot draws the scripts' two figures (CPU time, and CPU time per IPOPT iteration, over
-n_s or N, step form against Stewart's). Nothing is written unless asked.
+n_s or N, step form against Stewart's); --report runs nothing: it prints --csv's rows as a
+Markdown table (the one in docs/nosnoc-examples.md) and draws --plot from them. Nothing is
+written unless asked.
 
   python3 scripts/hopper_sweep.py ns --points 2,3 --csv /tmp/ns.csv --plot /tmp/ns.png
   python3 scripts/hopper_sweep.py ns --csv /tmp/ns.csv --resume      # the other points
+  python3 scripts/hopper_sweep.py ns --csv /tmp/ns.csv --report --plot /tmp/ns.png
 """
 import argparse
 import contextlib
@@ -112,6 +115,22 @@ def plot(rows, key, path):
     fig.savefig(path, dpi=80)
 
 
+def markdown(rows, key):
+    """The rows as the Markdown table of docs/nosnoc-examples.md, by point and form."""
+    name = "n_s" if key == "n_s" else "N"
+    lines = [f"| {name} | form | status | objective | qx(T) | NLPs | IPOPT iterations | CPU s "
+             "| CPU s per iteration |", "|---:|---|---|---:|---:|---:|---:|---:|---:|"]
+    for r in sorted(rows, key=lambda r: (r["value"], r["form"])):
+        def cell(k, fmt):
+            return fmt % r[k] if r.get(k) is not None else "-"
+        qx = r["x_final"].split()[0] if r.get("x_final") else "-"
+        lines.append(f"| {r['value']} | {'Stewart' if r['form'] == 'stewart' else 'step'} | "
+                     f"{r['status']} | {cell('objective', '%.6g')} | {qx} | {cell('nlps', '%d')} "
+                     f"| {cell('ipopt_iterations', '%d')} | {cell('cpu_nlp_s', '%.0f')} | "
+                     f"{cell('cpu_per_iteration_s', '%.3f')} |")
+    return "\n".join(lines)
+
+
 def read_rows(path, key):
     """The rows of an earlier run's CSV (numbers back as numbers), for --resume."""
     if not pathlib.Path(path).exists():
@@ -144,6 +163,8 @@ def main():
     a.add_argument("--resume", action="store_true",
                    help="keep the finished rows of --csv's file and run only the other points")
     a.add_argument("--plot", help="draw the scripts' two figures (PNG/SVG)")
+    a.add_argument("--report", action="store_true",
+                   help="run nothing: print --csv's rows as a Markdown table (and draw --plot)")
     a.add_argument("--keep", metavar="DIR",
                    help="keep each point's problem file, JSON result and log in DIR (default: "
                         "a temporary directory, removed at the end)")
@@ -163,6 +184,14 @@ def main():
             import matplotlib  # noqa: F401
         except ImportError:
             a.error("--plot needs matplotlib (Debian: python3-matplotlib, e.g. run /usr/bin/python3)")
+    if args.report:
+        if not args.csv or not pathlib.Path(args.csv).exists():
+            a.error("--report needs --csv with an earlier run's file")
+        rows = read_rows(args.csv, key)
+        print(markdown(rows, key))
+        if args.plot:
+            plot(rows, key, args.plot)
+        return
     if not pathlib.Path(args.fesd).exists():
         a.error(f"no fesd binary at {args.fesd} (build it or pass --fesd)")
     rows = []
