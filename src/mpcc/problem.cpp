@@ -217,9 +217,14 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
       // point of the relaxed problem, and the homotopy goes on from it; one that does not is no
       // start for the next sigma.
       const bool unusable = r.eval_error || !(r.inf_pr <= kFeasibleFailure);
+      // The schedule's last NLP: the homotopy cannot go on from its point, a failure there ends
+      // it failed, so it is retried even where its point is feasible.
+      const bool ends_schedule =
+          on_schedule && (sigma <= o.sigma_N || scheduled + 1 >= max_steps + (tight_now ? 1 : 0));
       // (Only after a sigma step: the tight re-solve at a loosely converged NLP's sigma has none
       // to make smaller.)
-      if (!last_ok && unusable && good && sigma < sigma_good && retries < o.homotopy_retries) {
+      if (!last_ok && (unusable || ends_schedule) && good && sigma < sigma_good &&
+          retries < o.homotopy_retries) {
         // Back to the last converged NLP's point, and a sigma step of half the logarithm
         // (sigma_good * sqrt(sigma / sigma_good)) towards the same target.
         res.rows.back().retried = true;

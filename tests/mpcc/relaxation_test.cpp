@@ -430,6 +430,33 @@ fesd::HomotopyOptions homotopy_down_to(double sigma_N, int retries) {
   return options;
 }
 
+// The schedule's last NLP (sigma = 1e-3 = sigma_N) fails at a feasible point (as row 28's Stewart
+// point N_stages = 84 of docs/nosnoc-examples.md, Restoration_Failed at inf_pr 0): the homotopy
+// cannot go on from it, so it is retried like an infeasible failure, from the point of sigma =
+// 1e-2, and ends at the MPCC's solution. Without retries: nlp_failed at the failed point.
+TEST(HomotopyRetries, FeasibleFailureOfTheLastNlpIsRetried) {
+  TinyProblem p(1.0);
+  FailingSolver solver({}, 1.0, /*feasible=*/{2});
+  const auto res = p.problem.solve_homotopy(solver, homotopy_down_to(1e-3, 4));
+  ASSERT_EQ(res.status, fesd::Status::Success) << res.last_nlp_status;
+  const std::vector<double> s = sigmas(res);
+  ASSERT_EQ(s.size(), 5u);
+  EXPECT_TRUE(res.rows[2].retried);
+  EXPECT_NEAR(s[3], std::pow(10.0, -2.5), 1e-17);
+  EXPECT_NEAR(s[4], 1e-3, 1e-18);
+  EXPECT_EQ(solver.starts[3][p.x], solver.starts[2][p.x]);  // from the point of sigma = 1e-2
+  EXPECT_NEAR(p.at(p.x), 1.0, 2e-3);
+  EXPECT_NEAR(p.at(p.y), 0.0, 2e-3);
+
+  TinyProblem q(1.0);
+  FailingSolver plain({}, 1.0, /*feasible=*/{2});
+  const auto res0 = q.problem.solve_homotopy(plain, homotopy_down_to(1e-3, 0));
+  EXPECT_EQ(res0.status, fesd::Status::NlpFailed);
+  ASSERT_EQ(res0.rows.size(), 3u);
+  EXPECT_FALSE(res0.rows[2].retried);
+  EXPECT_EQ(q.at(q.x), 5.0);
+}
+
 // sigma = 0.1, 0.01, 1e-3, 1e-4 (complementarity_tol 1e-4), no retries. The NLPs at 1e-3 and 1e-4
 // fail at points that violate the constraints, so the homotopy would end nlp_failed: it solves
 // sigma = 1e-3 again from the initial guess (cold), and goes on from there to the MPCC's solution
