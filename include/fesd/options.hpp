@@ -179,7 +179,8 @@ struct HomotopyOptions {
   /// one point), then on to the failed sigma; at most this many
   /// times per homotopy (the retried NLPs and the smaller steps after them do not count towards
   /// N_homotopy). A failed NLP that ends feasible (e.g. at max_iter) is kept, and so is every
-  /// failed NLP with 0: the homotopy goes on from its point, as nosnoc's does.
+  /// failed NLP with 0: the homotopy goes on from its point, as nosnoc's does. The schedule's
+  /// last NLP is retried also where it fails feasible (no NLP follows it to go on to).
   int homotopy_retries = 4;
   /// `homotopy_cold_restart` (optimal control): a homotopy that would end with a failed NLP, after
   /// an NLP that failed at a point violating the constraints with no retry left
