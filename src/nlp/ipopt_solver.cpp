@@ -498,11 +498,12 @@ NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_star
   double pivtol = 1e-8, pivtolmax = 1e-4;  // IPOPT's defaults, unless set in [ipopt]
   app.Options()->GetNumericValue("ma27_pivtol", pivtol, "");
   app.Options()->GetNumericValue("ma27_pivtolmax", pivtolmax, "");
-  const std::vector<RetryRung> rungs = retry_ladder({.warm_retry = warm_retry,
-                                                     .sparse_ldl = mode == FESD_KKT_SPARSE,
-                                                     .fresh_scaling = fresh_scaling,
-                                                     .pivtol = pivtol,
-                                                     .retry_pivtol = kRetryPivtol});
+  const RetryLadderInput ladder{.warm_retry = warm_retry,
+                                .sparse_ldl = mode == FESD_KKT_SPARSE,
+                                .fresh_scaling = fresh_scaling,
+                                .pivtol = pivtol,
+                                .retry_pivtol = kRetryPivtol};
+  const std::vector<RetryRung> rungs = retry_ladder(ladder);
   for (const RetryRung rung : rungs) {
     if (!may_cure()) break;
     switch (rung) {
@@ -518,18 +519,25 @@ NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_star
         break;
       case RetryRung::FreshScaling:
         again(
-            mode, "again with kkt_scaling fresh", [&] { fresh_scaling = true; },
-            [&] { fresh_scaling = false; });
+            mode, "again with kkt_scaling fresh",
+            [&] { fresh_scaling = fresh_scaling_on(rung, ladder); },
+            [&] { fresh_scaling = ladder.fresh_scaling; });
         break;
       case RetryRung::StricterPivoting:
         again(
-            mode, fmt::format("again with ma27_pivtol {:g}", kRetryPivtol),
+            mode,
+            fmt::format("again with ma27_pivtol {:g}{}", kRetryPivtol,
+                        fresh_scaling_on(rung, ladder) && !ladder.fresh_scaling
+                            ? " and kkt_scaling fresh"
+                            : ""),
             [&] {
+              fresh_scaling = fresh_scaling_on(rung, ladder);
               app.Options()->SetNumericValue("ma27_pivtol", kRetryPivtol);
               app.Options()->SetNumericValue("ma27_pivtolmax",
                                              std::max(pivtolmax, kRetryPivtolMax));
             },
             [&] {
+              fresh_scaling = ladder.fresh_scaling;
               app.Options()->SetNumericValue("ma27_pivtol", pivtol);
               app.Options()->SetNumericValue("ma27_pivtolmax", pivtolmax);
             });

@@ -7,7 +7,8 @@
 //                     (or, after a monotone first run, the adaptive one);
 //   FreshScaling      on fesd's sparse LDL' with the warm-started scaling: the scaling from the
 //                     identity at every factorization (kkt_scaling = fresh);
-//   StricterPivoting  on the sparse LDL' below the retry's pivot tolerance: ma27_pivtol raised;
+//   StricterPivoting  on the sparse LDL' below the retry's pivot tolerance: ma27_pivtol raised,
+//                     with the scaling from the identity (kkt_scaling = fresh) as well;
 //   Mumps             on the sparse LDL': IPOPT's MUMPS.
 #pragma once
 #include <vector>
@@ -33,6 +34,24 @@ inline std::vector<RetryRung> retry_ladder(const RetryLadderInput& in) {
   if (in.pivtol < in.retry_pivtol) rungs.push_back(RetryRung::StricterPivoting);
   rungs.push_back(RetryRung::Mumps);
   return rungs;
+}
+
+/// Whether a rung factorizes with the scaling from the identity (kkt_scaling = fresh) on the
+/// sparse LDL'. The stricter pivoting does, whatever the first run's scaling: a raised pivot
+/// tolerance on the warm-started scaling cascades into delayed pivots on the hopper OCPs (20 s
+/// per IPOPT iteration against 0.3 s fresh; docs/kkt-solver.md, "The stricter pivoting's
+/// scaling").
+inline bool fresh_scaling_on(RetryRung rung, const RetryLadderInput& in) {
+  switch (rung) {
+    case RetryRung::FreshScaling:
+    case RetryRung::StricterPivoting:
+      return true;
+    case RetryRung::OtherMuStrategy:
+      return in.fresh_scaling;
+    case RetryRung::Mumps:
+      return false;
+  }
+  return false;
 }
 
 }  // namespace fesd::nlp

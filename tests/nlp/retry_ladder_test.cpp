@@ -7,6 +7,7 @@
 
 namespace {
 
+using fesd::nlp::fresh_scaling_on;
 using fesd::nlp::retry_ladder;
 using fesd::nlp::RetryLadderInput;
 using Rung = fesd::nlp::RetryRung;
@@ -30,6 +31,16 @@ TEST(RetryLadder, SkipsWhatTheFirstRunAlreadyHad) {
             (std::vector{Rung::FreshScaling, Rung::Mumps}));
   EXPECT_EQ(retry_ladder({.sparse_ldl = true, .pivtol = 0.5, .retry_pivtol = 1e-2}),
             (std::vector{Rung::FreshScaling, Rung::Mumps}));
+}
+
+TEST(RetryLadder, StricterPivotingFactorizesWithTheFreshScaling) {
+  const RetryLadderInput warm{.warm_retry = true, .sparse_ldl = true};
+  EXPECT_FALSE(fresh_scaling_on(Rung::OtherMuStrategy, warm));
+  EXPECT_TRUE(fresh_scaling_on(Rung::FreshScaling, warm));
+  EXPECT_TRUE(fresh_scaling_on(Rung::StricterPivoting, warm));
+  const RetryLadderInput fresh{.warm_retry = true, .sparse_ldl = true, .fresh_scaling = true};
+  EXPECT_TRUE(fresh_scaling_on(Rung::OtherMuStrategy, fresh));
+  EXPECT_TRUE(fresh_scaling_on(Rung::StricterPivoting, fresh));
 }
 
 TEST(RetryLadder, OtherSolversOnlyChangeTheMuStrategy) {
