@@ -250,7 +250,8 @@ const KktModule& kkt_module() {
 /// the most IPOPT may raise it to. IPOPT's defaults are 1e-8 and 1e-4. Measured on
 /// examples/nosnoc/hopper_exercise_ocp_step.toml (docs/kkt-solver.md, "Retry, then fallback"):
 /// NLP 4's first run ends Restoration_Failed after 563 iterations; again with 1e-2 it solves in
-/// 434 (with 1e-4: 883), where MUMPS took 382 at 4-5 times the cost per iteration.
+/// 434 (with 1e-4: 883), where MUMPS took 382 at 4-5 times the cost per iteration. (That was
+/// with the warm-started scaling; the run now factorizes with the fresh one: fresh_scaling_on.)
 constexpr double kRetryPivtol = 1e-2;
 constexpr double kRetryPivtolMax = 0.5;
 
