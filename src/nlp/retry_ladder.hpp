@@ -38,9 +38,9 @@ inline std::vector<RetryRung> retry_ladder(const RetryLadderInput& in) {
 
 /// Whether a rung factorizes with the scaling from the identity (kkt_scaling = fresh) on the
 /// sparse LDL'. The stricter pivoting does, whatever the first run's scaling: a raised pivot
-/// tolerance on the warm-started scaling cascades into delayed pivots on the hopper OCPs (20 s
-/// per IPOPT iteration against 0.3 s fresh; docs/kkt-solver.md, "The stricter pivoting's
-/// scaling").
+/// tolerance on the warm-started scaling cascades into delayed pivots on the hopper OCPs (3.6 s
+/// per IPOPT iteration on average and up to minutes, against 0.4 s fresh; docs/kkt-solver.md,
+/// "The stricter pivoting's scaling").
 inline bool fresh_scaling_on(RetryRung rung, const RetryLadderInput& in) {
   switch (rung) {
     case RetryRung::FreshScaling:
