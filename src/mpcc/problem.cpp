@@ -192,8 +192,9 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
   // smaller steps after them (at most 2 homotopy_retries) do not. One NLP more than max_steps if
   // the last one met the tolerance only loosely (below).
   int scheduled = 0;
+  const auto schedule_length = [&] { return max_steps + (tight_now ? 1 : 0); };
   for (;;) {
-    for (; scheduled < max_steps + (tight_now ? 1 : 0);) {
+    for (; scheduled < schedule_length();) {
       const int k = static_cast<int>(res.rows.size());
       const bool on_schedule = sigma == target;
       apply_sigma(*relaxation_, nlp_, it_, sigma);
@@ -220,7 +221,7 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
       // The schedule's last NLP: the homotopy cannot go on from its point, a failure there ends
       // it failed, so it is retried even where its point is feasible.
       const bool ends_schedule =
-          on_schedule && (sigma <= o.sigma_N || scheduled + 1 >= max_steps + (tight_now ? 1 : 0));
+          on_schedule && (sigma <= o.sigma_N || scheduled + 1 >= schedule_length());
       // (Only after a sigma step: the tight re-solve at a loosely converged NLP's sigma has none
       // to make smaller.)
       if (!last_ok && (unusable || ends_schedule) && good && sigma < sigma_good &&

@@ -507,6 +507,7 @@ NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_star
   const std::vector<RetryRung> rungs = retry_ladder(ladder);
   for (const RetryRung rung : rungs) {
     if (!may_cure()) break;
+    fresh_scaling = fresh_scaling_on(rung, ladder);  // each rung's scaling (the run reads it)
     switch (rung) {
       case RetryRung::OtherMuStrategy:
         if (monotone_first) {
@@ -520,25 +521,19 @@ NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_star
         break;
       case RetryRung::FreshScaling:
         again(
-            mode, "again with kkt_scaling fresh",
-            [&] { fresh_scaling = fresh_scaling_on(rung, ladder); },
-            [&] { fresh_scaling = ladder.fresh_scaling; });
+            mode, "again with kkt_scaling fresh", [] {}, [] {});
         break;
       case RetryRung::StricterPivoting:
         again(
             mode,
             fmt::format("again with ma27_pivtol {:g}{}", kRetryPivtol,
-                        fresh_scaling_on(rung, ladder) && !ladder.fresh_scaling
-                            ? " and kkt_scaling fresh"
-                            : ""),
+                        fresh_scaling && !ladder.fresh_scaling ? " and kkt_scaling fresh" : ""),
             [&] {
-              fresh_scaling = fresh_scaling_on(rung, ladder);
               app.Options()->SetNumericValue("ma27_pivtol", kRetryPivtol);
               app.Options()->SetNumericValue("ma27_pivtolmax",
                                              std::max(pivtolmax, kRetryPivtolMax));
             },
             [&] {
-              fresh_scaling = ladder.fresh_scaling;
               app.Options()->SetNumericValue("ma27_pivtol", pivtol);
               app.Options()->SetNumericValue("ma27_pivtolmax", pivtolmax);
             });
