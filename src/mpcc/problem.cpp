@@ -204,9 +204,26 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
       const bool loose = !tight_now && o.intermediate_tol > 0 &&
                          sigma > kTightSigmaFactor * o.complementarity_tol && sigma > o.sigma_N;
       const bool warm = k > 0 && !cold_now;
+      // The schedule's last NLP: the homotopy cannot go on from its point, a failure there ends
+      // it failed, so it is retried even where its point is feasible.
+      const bool ends_schedule =
+          on_schedule && (sigma <= o.sigma_N || scheduled + 1 >= schedule_length());
+      // Whether a failure of this NLP is retried below: back to the last converged NLP with a
+      // smaller sigma step. A failed NLP whose point still satisfies the constraints (e.g. at
+      // max_iter) is a feasible point of the relaxed problem, and the homotopy goes on from it;
+      // one that does not is no start for the next sigma. (Only after a sigma step: the tight
+      // re-solve at a loosely converged NLP's sigma has none to make smaller.) The NLP solver
+      // asks it too, and then leaves out its linear-algebra fallbacks (nlp::CallerRetries).
+      const auto unusable = [](const nlp::NlpResult& f) {
+        return f.eval_error || !(f.inf_pr <= kFeasibleFailure);
+      };
+      const auto retried_here = [&](const nlp::NlpResult& f) {
+        return !f.success && (unusable(f) || ends_schedule) && good && sigma < sigma_good &&
+               retries < o.homotopy_retries;
+      };
       const nlp::NlpResult r =
           solver.solve(nlp_, it_, /*warm_start=*/warm, loose ? o.intermediate_tol : 0.0,
-                       warm ? warm_max_iter : 0);
+                       warm ? warm_max_iter : 0, retried_here);
       res.comp_residual = comp_residual(it_.x.data(), residual_pairs_);
       record(res, r, k, sigma);
       res.rows.back().cold_start = cold_now;
@@ -214,18 +231,7 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
       sigma_ = sigma;
       last_ok = r.success;
       eval_failed = r.eval_error;
-      // A failed NLP whose point still satisfies the constraints (e.g. at max_iter) is a feasible
-      // point of the relaxed problem, and the homotopy goes on from it; one that does not is no
-      // start for the next sigma.
-      const bool unusable = r.eval_error || !(r.inf_pr <= kFeasibleFailure);
-      // The schedule's last NLP: the homotopy cannot go on from its point, a failure there ends
-      // it failed, so it is retried even where its point is feasible.
-      const bool ends_schedule =
-          on_schedule && (sigma <= o.sigma_N || scheduled + 1 >= schedule_length());
-      // (Only after a sigma step: the tight re-solve at a loosely converged NLP's sigma has none
-      // to make smaller.)
-      if (!last_ok && (unusable || ends_schedule) && good && sigma < sigma_good &&
-          retries < o.homotopy_retries) {
+      if (retried_here(r)) {
         // Back to the last converged NLP's point, and a sigma step of half the logarithm
         // (sigma_good * sqrt(sigma / sigma_good)) towards the same target.
         res.rows.back().retried = true;
@@ -241,7 +247,7 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
       // No retry left (or none possible): the homotopy goes on from the failed point, and where
       // the cold restart would start if it ends failed (the first such NLP: `cold` stays set
       // after the restart too).
-      if (!last_ok && unusable && k > 0 && !cold) cold = ColdStart{k, target, scheduled};
+      if (!last_ok && unusable(r) && k > 0 && !cold) cold = ColdStart{k, target, scheduled};
       if (on_row) on_row(res.rows.back());
       if (on_schedule) ++scheduled;
       if (last_ok && o.homotopy_retries > 0) {  // (no copy when nothing can be retried)
@@ -309,7 +315,8 @@ HomotopyResult Problem::solve_again(nlp::NlpSolver& solver, const HomotopyOption
     trial.x[c.var] = std::clamp(trial.x[c.var], c.lb, c.ub);
   }
   apply_sigma(*relaxation_, nlp_, trial, sigma_);
-  const nlp::NlpResult r = solver.solve(nlp_, trial, /*warm_start=*/true, 0.0, kSolveAgainMaxIter);
+  const nlp::NlpResult r = solver.solve(nlp_, trial, /*warm_start=*/true, 0.0, kSolveAgainMaxIter,
+                                        /*caller_retries=*/{});
   nlp_.x_lb = x_lb;
   nlp_.x_ub = x_ub;
   res.comp_residual = comp_residual(trial.x.data(), residual_pairs_);

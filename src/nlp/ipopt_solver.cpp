@@ -375,7 +375,7 @@ std::vector<std::string> warnings(const NlpOptions& o) {
 }
 
 NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_start, double tol,
-                             int max_iter) {
+                             int max_iter, const CallerRetries& caller_retries) {
   const auto t0 = Clock::now();
   const double cpu0 = util::thread_cpu_seconds();
   Ipopt::IpoptApplication& app = *impl_->app;
@@ -507,6 +507,11 @@ NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_star
   const std::vector<RetryRung> rungs = retry_ladder(ladder);
   for (const RetryRung rung : rungs) {
     if (!may_cure()) break;
+    if (changes_linear_algebra_only(rung) && caller_retries && caller_retries(r)) {
+      // (Every run so far was on `mode`: only the mu strategy precedes these rungs.)
+      r.linear_solver = fmt::format("{} ({}; then left to the caller's retry)", name, tried);
+      break;
+    }
     fresh_scaling = fresh_scaling_on(rung, ladder);  // each rung's scaling (the run reads it)
     switch (rung) {
       case RetryRung::OtherMuStrategy:

@@ -12,8 +12,8 @@ class IpoptSolver final : public NlpSolver {
   /// fesd::InvalidOption if IPOPT rejects an option (the message names it).
   explicit IpoptSolver(const NlpOptions& options);
   ~IpoptSolver() override;
-  NlpResult solve(const BlockNlp& nlp, Iterate& start, bool warm_start, double tol,
-                  int max_iter) override;
+  NlpResult solve(const BlockNlp& nlp, Iterate& start, bool warm_start, double tol, int max_iter,
+                  const CallerRetries& caller_retries) override;
 
  private:
   struct Impl;

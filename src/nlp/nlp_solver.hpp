@@ -2,6 +2,7 @@
 // systems solved by fesd's module or MUMPS) is the one backend today; a structure-exploiting solver
 // can replace it behind this interface.
 #pragma once
+#include <functional>
 #include <memory>
 #include <string>
 #include <utility>
@@ -29,7 +30,9 @@ struct NlpResult {
   /// (again with mu_strategy monotone from mu_init 0.0001; first run: STATUS after N
   /// iterations)", "sparse_ldl (again with ma27_pivtol 0.01; ...)", "mumps (sparse_ldl fallback;
   /// ...)"; a warm start run monotone first because an NLP before needed it: "sparse_ldl
-  /// (mu_strategy monotone from mu_init 0.0001, as an NLP before needed)".
+  /// (mu_strategy monotone from mu_init 0.0001, as an NLP before needed)"; failed runs the caller
+  /// retries itself (CallerRetries): "sparse_ldl (first run: ...; again with ...: ...; then left
+  /// to the caller's retry)".
   std::string linear_solver;
   int iterations = 0;  ///< IPOPT iterations; after a retry or fallback those of every run
   double objective = 0, inf_pr = 0, inf_du = 0;
@@ -42,15 +45,23 @@ struct NlpResult {
   long long factorizations = 0;
 };
 
+/// Whether the caller solves a failed NLP again itself, given the failed result: the homotopy
+/// does from its last converged NLP with a smaller sigma step (homotopy_retries). A backend then
+/// leaves out the retries that change the linear algebra (the fresh scaling, the stricter
+/// pivoting and the MUMPS fallback of nlp/retry_ladder.hpp) and returns the failure: on the
+/// hopper OCPs these never cured a warm-started NLP, the smaller step did, in about a twentieth
+/// of the time (docs/kkt-solver.md, "The caller's retry first"). Empty: the caller does not.
+using CallerRetries = std::function<bool(const NlpResult& failed)>;
+
 class NlpSolver {
  public:
   virtual ~NlpSolver() = default;
   /// Solves from `start` (x; with duals when warm-starting) and overwrites it with the solution.
   /// tol > 0 replaces the configured convergence tolerance for this solve when it is looser
   /// (the early NLPs of a homotopy); 0 keeps it. max_iter > 0 replaces the configured iteration
-  /// limit when it is lower; 0 keeps it.
+  /// limit when it is lower; 0 keeps it. `caller_retries` (may be empty): see CallerRetries.
   virtual NlpResult solve(const BlockNlp& nlp, Iterate& start, bool warm_start, double tol,
-                          int max_iter) = 0;
+                          int max_iter, const CallerRetries& caller_retries) = 0;
   /// From now on, each solve calls `on_progress` after an iteration at most every `every_s`
   /// seconds of wall time (0: after every iteration); an empty callback: never (the default).
   void set_progress(NlpProgressCallback on_progress, double every_s) {

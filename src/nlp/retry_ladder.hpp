@@ -10,6 +10,8 @@
 //   StricterPivoting  on the sparse LDL' below the retry's pivot tolerance: ma27_pivtol raised,
 //                     with the scaling from the identity (kkt_scaling = fresh) as well;
 //   Mumps             on the sparse LDL': IPOPT's MUMPS.
+// The last three change the linear algebra only; a caller that retries the failure itself (the
+// homotopy's smaller sigma step, nlp::CallerRetries) gets it back before them.
 #pragma once
 #include <vector>
 
@@ -34,6 +36,14 @@ inline std::vector<RetryRung> retry_ladder(const RetryLadderInput& in) {
   if (in.pivtol < in.retry_pivtol) rungs.push_back(RetryRung::StricterPivoting);
   rungs.push_back(RetryRung::Mumps);
   return rungs;
+}
+
+/// Whether a rung changes only how the KKT systems are solved (scaling, pivoting, solver), not
+/// IPOPT's path: the rungs left out when the caller retries the failure itself. Measured on the
+/// hopper sweeps (docs/kkt-solver.md, "The caller's retry first"): of the warm-started NLPs these
+/// rungs ran on, none solved (1000-1700 s each), and the homotopy's smaller step then did.
+inline bool changes_linear_algebra_only(RetryRung rung) {
+  return rung != RetryRung::OtherMuStrategy;
 }
 
 /// Whether a rung factorizes with the scaling from the identity (kkt_scaling = fresh) on the

@@ -43,6 +43,15 @@ TEST(RetryLadder, StricterPivotingFactorizesWithTheFreshScaling) {
   EXPECT_TRUE(fresh_scaling_on(Rung::StricterPivoting, fresh));
 }
 
+TEST(RetryLadder, OnlyTheMuStrategyRunsBeforeTheCallersRetry) {
+  // A caller that retries the failure itself (the homotopy) gets it back after the mu strategy's
+  // run: the other rungs only change the linear algebra.
+  EXPECT_FALSE(fesd::nlp::changes_linear_algebra_only(Rung::OtherMuStrategy));
+  EXPECT_TRUE(fesd::nlp::changes_linear_algebra_only(Rung::FreshScaling));
+  EXPECT_TRUE(fesd::nlp::changes_linear_algebra_only(Rung::StricterPivoting));
+  EXPECT_TRUE(fesd::nlp::changes_linear_algebra_only(Rung::Mumps));
+}
+
 TEST(RetryLadder, OtherSolversOnlyChangeTheMuStrategy) {
   // MUMPS, the dense LDL' or an [ipopt] linear_solver: no scaling, pivoting or fallback rungs.
   EXPECT_EQ(retry_ladder({.warm_retry = true}), (std::vector{Rung::OtherMuStrategy}));
