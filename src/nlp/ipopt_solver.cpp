@@ -505,13 +505,7 @@ NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_star
                                 .pivtol = pivtol,
                                 .retry_pivtol = kRetryPivtol};
   const std::vector<RetryRung> rungs = retry_ladder(ladder);
-  for (const RetryRung rung : rungs) {
-    if (!may_cure()) break;
-    if (changes_linear_algebra_only(rung) && caller_retries && caller_retries(r)) {
-      // (Every run so far was on `mode`: only the mu strategy precedes these rungs.)
-      r.linear_solver = fmt::format("{} ({}; then left to the caller's retry)", name, tried);
-      break;
-    }
+  const auto run_rung = [&](RetryRung rung) {
     fresh_scaling = fresh_scaling_on(rung, ladder);  // each rung's scaling (the run reads it)
     switch (rung) {
       case RetryRung::OtherMuStrategy:
@@ -548,7 +542,12 @@ NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_star
             -1, "sparse_ldl fallback", [] {}, [] {});
         break;
     }
-  }
+  };
+  const bool left_to_caller = climb(
+      rungs, may_cure, [&] { return caller_retries && caller_retries(r); }, run_rung);
+  // (Every run so far was on `mode`: only the mu strategy precedes the rungs left out.)
+  if (left_to_caller)
+    r.linear_solver = fmt::format("{} ({}; then left to the caller's retry)", name, tried);
   r.total_s = seconds_since(t0);
   r.cpu_s = util::thread_cpu_seconds() - cpu0;
   return r;

@@ -40,10 +40,25 @@ inline std::vector<RetryRung> retry_ladder(const RetryLadderInput& in) {
 
 /// Whether a rung changes only how the KKT systems are solved (scaling, pivoting, solver), not
 /// IPOPT's path: the rungs left out when the caller retries the failure itself. Measured on the
-/// hopper sweeps (docs/kkt-solver.md, "The caller's retry first"): of the warm-started NLPs these
-/// rungs ran on, none solved (1000-1700 s each), and the homotopy's smaller step then did.
+/// hopper sweeps (docs/kkt-solver.md, "The caller's retry first"): these rungs solved cold NLPs
+/// only; on the three warm-started NLPs they ran on, all failed (912-1694 s per NLP).
 inline bool changes_linear_algebra_only(RetryRung rung) {
   return rung != RetryRung::OtherMuStrategy;
+}
+
+/// Climbs the ladder after a failed first run: each rung in turn while `may_cure()` (the last
+/// run failed in a way another setting may cure), `run(rung)` running it. Before each rung that
+/// changes only the linear algebra it asks `caller_retries()` about the last run's failure and
+/// stops on yes. Returns true if it stopped so (the failure is left to the caller's retry).
+template <class MayCure, class CallerRetriesNow, class Run>
+bool climb(const std::vector<RetryRung>& rungs, MayCure may_cure, CallerRetriesNow caller_retries,
+           Run run) {
+  for (const RetryRung rung : rungs) {
+    if (!may_cure()) return false;
+    if (changes_linear_algebra_only(rung) && caller_retries()) return true;
+    run(rung);
+  }
+  return false;
 }
 
 /// Whether a rung factorizes with the scaling from the identity (kkt_scaling = fresh) on the

@@ -306,7 +306,8 @@ class FailingSolver : public fesd::nlp::NlpSolver {
     fesd::nlp::NlpResult r;
     r.status = "Infeasible_Problem_Detected";
     r.inf_pr = feasible ? 1e-9 : inf_pr_;
-    // What IPOPT's retry ladder asks before its linear-algebra fallbacks.
+    // The homotopy's answer for this failure (IPOPT's ladder asks it about the statuses it
+    // retries, not Infeasible_Problem_Detected; the answer does not read the status).
     caller_retries_failure.push_back(caller_retries && caller_retries(r) ? 1 : 0);
     return r;
   }

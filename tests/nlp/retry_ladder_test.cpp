@@ -52,6 +52,47 @@ TEST(RetryLadder, OnlyTheMuStrategyRunsBeforeTheCallersRetry) {
   EXPECT_TRUE(fesd::nlp::changes_linear_algebra_only(Rung::Mumps));
 }
 
+/// climb() with runs that fail until `solved_on` (or never), recording the rungs run.
+struct FakeLadder {
+  std::vector<Rung> ran;
+  bool failed = true;
+  std::vector<Rung> run(const std::vector<Rung>& rungs, int caller_retries_from, int solved_on,
+                        bool* left) {
+    *left = fesd::nlp::climb(
+        rungs, [&] { return failed; },
+        [&] { return static_cast<int>(ran.size()) >= caller_retries_from; },
+        [&](Rung rung) {
+          ran.push_back(rung);
+          failed = static_cast<int>(ran.size()) != solved_on;
+        });
+    return ran;
+  }
+};
+
+TEST(RetryLadder, ClimbStopsWhereTheCallerRetries) {
+  const std::vector<Rung> warm = retry_ladder({.warm_retry = true, .sparse_ldl = true});
+  constexpr int kNever = 100;
+  bool left = false;
+  // The caller retries every failure: only the mu strategy's run, then back to the caller.
+  EXPECT_EQ(FakeLadder{}.run(warm, 0, kNever, &left), (std::vector{Rung::OtherMuStrategy}));
+  EXPECT_TRUE(left);
+  // It does not: every rung.
+  EXPECT_EQ(FakeLadder{}.run(warm, kNever, kNever, &left), warm);
+  EXPECT_FALSE(left);
+  // Solved by the fresh scaling: no further rung, nothing left to the caller.
+  EXPECT_EQ(FakeLadder{}.run(warm, kNever, 2, &left),
+            (std::vector{Rung::OtherMuStrategy, Rung::FreshScaling}));
+  EXPECT_FALSE(left);
+  // Asked again before each rung about the last run's failure: a caller that retries only the
+  // failure of the second run (e.g. one that ended infeasible) gets it back there.
+  EXPECT_EQ(FakeLadder{}.run(warm, 2, kNever, &left),
+            (std::vector{Rung::OtherMuStrategy, Rung::FreshScaling}));
+  EXPECT_TRUE(left);
+  // Without a mu-strategy rung (a cold NLP, or [ipopt] mu_strategy): back before any run.
+  EXPECT_TRUE(FakeLadder{}.run(retry_ladder({.sparse_ldl = true}), 0, kNever, &left).empty());
+  EXPECT_TRUE(left);
+}
+
 TEST(RetryLadder, OtherSolversOnlyChangeTheMuStrategy) {
   // MUMPS, the dense LDL' or an [ipopt] linear_solver: no scaling, pivoting or fallback rungs.
   EXPECT_EQ(retry_ladder({.warm_retry = true}), (std::vector{Rung::OtherMuStrategy}));
