@@ -508,6 +508,19 @@ TEST(HomotopyRetries, TellsTheNlpSolverWhichFailuresItRetries) {
   EXPECT_TRUE(res_spent.rows[1].retried);
   EXPECT_EQ(spent.caller_retries_failure[2], 0);
   EXPECT_FALSE(res_spent.rows[2].retried);
+  // The tight re-solve at a loosely converged NLP's sigma has no smaller step to take: a failure
+  // there is not retried (min (x - 1)^2 + (y + 1)^2 meets complementarity at the first NLP).
+  TinyProblem t(-1.0);
+  fesd::HomotopyOptions loose = options;
+  loose.intermediate_tol = 1e-6;
+  loose.homotopy_retries = 4;
+  FailingSolver tight({1});
+  const auto res_tight = t.problem.solve_homotopy(tight, loose);
+  ASSERT_GE(res_tight.rows.size(), 2u);
+  EXPECT_EQ(res_tight.rows[1].sigma, res_tight.rows[0].sigma);
+  ASSERT_GE(tight.caller_retries_failure.size(), 2u);
+  EXPECT_EQ(tight.caller_retries_failure[1], 0);
+  EXPECT_FALSE(res_tight.rows[1].retried);
 }
 
 // sigma = 0.1, 0.01, 1e-3, 1e-4 (complementarity_tol 1e-4), no retries. The NLPs at 1e-3 and 1e-4
