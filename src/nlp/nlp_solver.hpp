@@ -49,9 +49,9 @@ struct NlpResult {
 /// does from its last converged NLP with a smaller sigma step (homotopy_retries). A backend then
 /// leaves out the retries that change the linear algebra (the fresh scaling, the stricter
 /// pivoting and the MUMPS fallback of nlp/retry_ladder.hpp) and returns the failure: on the
-/// hopper OCPs these cured cold NLPs only; on the one warm-started NLP measured both ways they
-/// failed in 1081 s where the smaller step solved in 60 s (docs/kkt-solver.md, "The caller's
-/// retry first"). The backend asks about the last run's failure before each such retry and
+/// hopper OCPs these cured cold NLPs only; on the last NLPs of two sweep points they failed
+/// (1081 s, 1694 s) where the smaller step then solved (60 s, 789 s; docs/kkt-solver.md, "The
+/// caller's retry first"). The backend asks about the last run's failure before each such retry and
 /// returns it on the first yes. Empty: the caller does not retry.
 using CallerRetries = std::function<bool(const NlpResult& failed)>;
 
