@@ -21,6 +21,13 @@ constexpr double kTightSigmaFactor = 10.0 * (1.0 + 1e-9);
 // failures that the retries mend end at 3.6e-3 .. 0.76.
 constexpr double kFeasibleFailure = 1e-6;
 
+// A failed NLP whose point violates the constraints (or whose evaluations failed): no start for
+// the next sigma. One that satisfies them (e.g. at max_iter) is a feasible point of the relaxed
+// problem, and the homotopy can go on from it.
+bool unusable(const nlp::NlpResult& r) {
+  return r.eval_error || !(r.inf_pr <= kFeasibleFailure);
+}
+
 // Adds the row of one NLP solve (k, sigma) to res and its times and iterations to the totals.
 void record(HomotopyResult& res, const nlp::NlpResult& r, int k, double sigma) {
   // r.objective is the NLP's objective: in the penalty modes (ell_1_penalty, elastic_*) it
@@ -209,14 +216,10 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
       const bool ends_schedule =
           on_schedule && (sigma <= o.sigma_N || scheduled + 1 >= schedule_length());
       // Whether a failure of this NLP is retried below: back to the last converged NLP with a
-      // smaller sigma step. A failed NLP whose point still satisfies the constraints (e.g. at
-      // max_iter) is a feasible point of the relaxed problem, and the homotopy goes on from it;
-      // one that does not is no start for the next sigma. (Only after a sigma step: the tight
-      // re-solve at a loosely converged NLP's sigma has none to make smaller.) The NLP solver
-      // asks it too, and then leaves out its linear-algebra fallbacks (nlp::CallerRetries).
-      const auto unusable = [](const nlp::NlpResult& f) {
-        return f.eval_error || !(f.inf_pr <= kFeasibleFailure);
-      };
+      // smaller sigma step, where the failed point is unusable or ends the schedule; a feasible
+      // failed point elsewhere is where the homotopy goes on from. (Only after a sigma step: the
+      // tight re-solve at a loosely converged NLP's sigma has none to make smaller.) The NLP
+      // solver asks it too, and then leaves out its linear-algebra fallbacks (nlp::CallerRetries).
       const auto retried_here = [&](const nlp::NlpResult& f) {
         return !f.success && (unusable(f) || ends_schedule) && good && sigma < sigma_good &&
                retries < o.homotopy_retries;
