@@ -41,7 +41,8 @@ inline std::vector<RetryRung> retry_ladder(const RetryLadderInput& in) {
 /// Whether a rung changes only how the KKT systems are solved (scaling, pivoting, solver), not
 /// IPOPT's path: the rungs left out when the caller retries the failure itself. Measured on the
 /// hopper sweeps (docs/kkt-solver.md, "The caller's retry first"): these rungs solved cold NLPs
-/// only; on the three warm-started NLPs they ran on, all failed (912-1694 s per NLP).
+/// only; every warm-started NLP they ran on (the last NLPs of three sweep points) failed on all
+/// of them (912-1694 s per NLP).
 inline bool changes_linear_algebra_only(RetryRung rung) {
   return rung != RetryRung::OtherMuStrategy;
 }
