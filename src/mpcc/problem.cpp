@@ -218,15 +218,21 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
       // Whether a failure of this NLP is retried below: back to the last converged NLP with a
       // smaller sigma step, where the failed point is unusable or ends the schedule; a feasible
       // failed point elsewhere is where the homotopy goes on from. (Only after a sigma step: the
-      // tight re-solve at a loosely converged NLP's sigma has none to make smaller.) The NLP
-      // solver asks it too, and then leaves out its linear-algebra fallbacks (nlp::CallerRetries).
+      // tight re-solve at a loosely converged NLP's sigma has none to make smaller.)
       const auto retried_here = [&](const nlp::NlpResult& f) {
         return !f.success && (unusable(f) || ends_schedule) && good && sigma < sigma_good &&
                retries < o.homotopy_retries;
       };
+      // The failures of a warm-started NLP that the homotopy handles itself: those it retries,
+      // and those at a feasible point that it goes on from (not the schedule's last). The NLP
+      // solver asks, and returns them before its linear-algebra fallbacks (nlp::CallerHandles).
+      // The first NLP and a cold restart keep every fallback: only there did they cure an NLP.
+      const auto handled_here = [&](const nlp::NlpResult& f) {
+        return retried_here(f) || (warm && !f.success && !unusable(f) && !ends_schedule);
+      };
       const nlp::NlpResult r =
           solver.solve(nlp_, it_, /*warm_start=*/warm, loose ? o.intermediate_tol : 0.0,
-                       warm ? warm_max_iter : 0, retried_here);
+                       warm ? warm_max_iter : 0, handled_here);
       res.comp_residual = comp_residual(it_.x.data(), residual_pairs_);
       record(res, r, k, sigma);
       res.rows.back().cold_start = cold_now;
@@ -319,7 +325,7 @@ HomotopyResult Problem::solve_again(nlp::NlpSolver& solver, const HomotopyOption
   }
   apply_sigma(*relaxation_, nlp_, trial, sigma_);
   const nlp::NlpResult r = solver.solve(nlp_, trial, /*warm_start=*/true, 0.0, kSolveAgainMaxIter,
-                                        /*caller_retries=*/{});
+                                        /*caller_handles=*/{});
   nlp_.x_lb = x_lb;
   nlp_.x_ub = x_ub;
   res.comp_residual = comp_residual(trial.x.data(), residual_pairs_);

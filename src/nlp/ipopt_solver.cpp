@@ -375,7 +375,7 @@ std::vector<std::string> warnings(const NlpOptions& o) {
 }
 
 NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_start, double tol,
-                             int max_iter, const CallerRetries& caller_retries) {
+                             int max_iter, const CallerHandles& caller_handles) {
   const auto t0 = Clock::now();
   const double cpu0 = util::thread_cpu_seconds();
   Ipopt::IpoptApplication& app = *impl_->app;
@@ -544,10 +544,10 @@ NlpResult IpoptSolver::solve(const BlockNlp& nlp, Iterate& start, bool warm_star
     }
   };
   const bool left_to_caller = climb(
-      rungs, may_cure, [&] { return caller_retries && caller_retries(r); }, run_rung);
+      rungs, may_cure, [&] { return caller_handles && caller_handles(r); }, run_rung);
   // (Every run so far was on `mode`: only the mu strategy precedes the rungs left out.)
   if (left_to_caller)
-    r.linear_solver = fmt::format("{} ({}; then left to the caller's retry)", name, tried);
+    r.linear_solver = fmt::format("{} ({}; then left to the caller)", name, tried);
   r.total_s = seconds_since(t0);
   r.cpu_s = util::thread_cpu_seconds() - cpu0;
   return r;

@@ -13,7 +13,7 @@ class IpoptSolver final : public NlpSolver {
   explicit IpoptSolver(const NlpOptions& options);
   ~IpoptSolver() override;
   NlpResult solve(const BlockNlp& nlp, Iterate& start, bool warm_start, double tol, int max_iter,
-                  const CallerRetries& caller_retries) override;
+                  const CallerHandles& caller_handles) override;
 
  private:
   struct Impl;

@@ -31,8 +31,8 @@ struct NlpResult {
   /// iterations)", "sparse_ldl (again with ma27_pivtol 0.01; ...)", "mumps (sparse_ldl fallback;
   /// ...)"; a warm start run monotone first because an NLP before needed it: "sparse_ldl
   /// (mu_strategy monotone from mu_init 0.0001, as an NLP before needed)"; failed runs the caller
-  /// retries itself (CallerRetries): "sparse_ldl (first run: ...; again with ...: ...; then left
-  /// to the caller's retry)".
+  /// handles itself (CallerHandles): "sparse_ldl (first run: ...; again with ...: ...; then left
+  /// to the caller)".
   std::string linear_solver;
   int iterations = 0;  ///< IPOPT iterations; after a retry or fallback those of every run
   double objective = 0, inf_pr = 0, inf_du = 0;
@@ -45,15 +45,18 @@ struct NlpResult {
   long long factorizations = 0;
 };
 
-/// Whether the caller solves a failed NLP again itself, given the failed result: the homotopy
-/// does from its last converged NLP with a smaller sigma step (homotopy_retries). A backend then
-/// leaves out the retries that change the linear algebra (the fresh scaling, the stricter
+/// Whether the caller handles a failed NLP itself, given the failed result. The homotopy does
+/// for a warm-started NLP: it solves it again from its last converged NLP with a smaller sigma
+/// step (homotopy_retries), or goes on from a failed feasible point to the next sigma. A backend
+/// then leaves out the retries that change the linear algebra (the fresh scaling, the stricter
 /// pivoting and the MUMPS fallback of nlp/retry_ladder.hpp) and returns the failure: on the
 /// hopper OCPs these cured cold NLPs only; on the last NLPs of two sweep points they failed
 /// (1081 s, 1694 s) where the smaller step then solved (60 s, 789 s; docs/kkt-solver.md, "The
-/// caller's retry first"). The backend asks about the last run's failure before each such retry and
-/// returns it on the first yes. Empty: the caller does not retry.
-using CallerRetries = std::function<bool(const NlpResult& failed)>;
+/// caller's retry first"), and on two NLPs the homotopy goes on from they failed the fresh-scaling
+/// and pivoting runs (docs/kkt-solver.md, "Failures the homotopy goes on from"). The backend asks
+/// about the last run's failure before each such retry and returns it on the first yes. Empty:
+/// the caller handles no failure.
+using CallerHandles = std::function<bool(const NlpResult& failed)>;
 
 class NlpSolver {
  public:
@@ -61,9 +64,9 @@ class NlpSolver {
   /// Solves from `start` (x; with duals when warm-starting) and overwrites it with the solution.
   /// tol > 0 replaces the configured convergence tolerance for this solve when it is looser
   /// (the early NLPs of a homotopy); 0 keeps it. max_iter > 0 replaces the configured iteration
-  /// limit when it is lower; 0 keeps it. `caller_retries` (may be empty): see CallerRetries.
+  /// limit when it is lower; 0 keeps it. `caller_handles` (may be empty): see CallerHandles.
   virtual NlpResult solve(const BlockNlp& nlp, Iterate& start, bool warm_start, double tol,
-                          int max_iter, const CallerRetries& caller_retries) = 0;
+                          int max_iter, const CallerHandles& caller_handles) = 0;
   /// From now on, each solve calls `on_progress` after an iteration at most every `every_s`
   /// seconds of wall time (0: after every iteration); an empty callback: never (the default).
   void set_progress(NlpProgressCallback on_progress, double every_s) {

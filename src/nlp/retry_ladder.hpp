@@ -10,8 +10,9 @@
 //   StricterPivoting  on the sparse LDL' below the retry's pivot tolerance: ma27_pivtol raised,
 //                     with the scaling from the identity (kkt_scaling = fresh) as well;
 //   Mumps             on the sparse LDL': IPOPT's MUMPS.
-// The last three change the linear algebra only; a caller that retries the failure itself (the
-// homotopy's smaller sigma step, nlp::CallerRetries) gets it back before them.
+// The last three change the linear algebra only; a caller that handles the failure itself (the
+// homotopy's smaller sigma step, or its next sigma from a feasible point; nlp::CallerHandles)
+// gets it back before them.
 #pragma once
 #include <vector>
 
@@ -39,24 +40,26 @@ inline std::vector<RetryRung> retry_ladder(const RetryLadderInput& in) {
 }
 
 /// Whether a rung changes only how the KKT systems are solved (scaling, pivoting, solver), not
-/// IPOPT's path: the rungs left out when the caller retries the failure itself. Measured on the
+/// IPOPT's path: the rungs left out when the caller handles the failure itself. Measured on the
 /// hopper sweeps (docs/kkt-solver.md, "The caller's retry first"): these rungs solved cold NLPs
-/// only; every warm-started NLP they ran on (the last NLPs of three sweep points) failed on all
-/// of them (912-1694 s per NLP).
+/// only; every warm-started NLP they ran on failed on all of them (the last NLPs of three sweep
+/// points, 912-1694 s per NLP) or on all that finished (two NLPs the homotopy goes on from, each
+/// stopped on its MUMPS run after 8400 and 3400 iterations: "Failures the homotopy goes on
+/// from").
 inline bool changes_linear_algebra_only(RetryRung rung) {
   return rung != RetryRung::OtherMuStrategy;
 }
 
 /// Climbs the ladder after a failed first run: each rung in turn while `may_cure()` (the last
 /// run failed in a way another setting may cure), `run(rung)` running it. Before each rung that
-/// changes only the linear algebra it asks `caller_retries()` about the last run's failure and
-/// stops on yes. Returns true if it stopped so (the failure is left to the caller's retry).
-template <class MayCure, class CallerRetriesNow, class Run>
-bool climb(const std::vector<RetryRung>& rungs, MayCure may_cure, CallerRetriesNow caller_retries,
+/// changes only the linear algebra it asks `caller_handles()` about the last run's failure and
+/// stops on yes. Returns true if it stopped so (the failure is left to the caller).
+template <class MayCure, class CallerHandlesNow, class Run>
+bool climb(const std::vector<RetryRung>& rungs, MayCure may_cure, CallerHandlesNow caller_handles,
            Run run) {
   for (const RetryRung rung : rungs) {
     if (!may_cure()) return false;
-    if (changes_linear_algebra_only(rung) && caller_retries()) return true;
+    if (changes_linear_algebra_only(rung) && caller_handles()) return true;
     run(rung);
   }
   return false;

@@ -167,10 +167,10 @@ class RecordingSolver : public fesd::nlp::NlpSolver {
  public:
   fesd::nlp::NlpResult solve(const fesd::nlp::BlockNlp& nlp, fesd::nlp::Iterate& start,
                              bool warm_start, double tol, int max_iter,
-                             const fesd::nlp::CallerRetries& caller_retries) override {
+                             const fesd::nlp::CallerHandles& caller_handles) override {
     tols.push_back(tol);
     max_iters.push_back(max_iter);
-    return inner_->solve(nlp, start, warm_start, tol, max_iter, caller_retries);
+    return inner_->solve(nlp, start, warm_start, tol, max_iter, caller_handles);
   }
   std::vector<double> tols;
   std::vector<int> max_iters;
@@ -293,14 +293,14 @@ class FailingSolver : public fesd::nlp::NlpSolver {
       : fail_(std::move(fail)), feasible_(std::move(feasible)), inf_pr_(inf_pr) {}
   fesd::nlp::NlpResult solve(const fesd::nlp::BlockNlp& nlp, fesd::nlp::Iterate& start,
                              bool warm_start, double tol, int max_iter,
-                             const fesd::nlp::CallerRetries& caller_retries) override {
+                             const fesd::nlp::CallerHandles& caller_handles) override {
     starts.push_back(start.x);
     warm.push_back(warm_start);
     const int call = calls_++;
     const bool feasible = std::find(feasible_.begin(), feasible_.end(), call) != feasible_.end();
     if (!feasible && std::find(fail_.begin(), fail_.end(), call) == fail_.end()) {
-      caller_retries_failure.push_back(-1);
-      return inner_->solve(nlp, start, warm_start, tol, max_iter, caller_retries);
+      caller_handles_failure.push_back(-1);
+      return inner_->solve(nlp, start, warm_start, tol, max_iter, caller_handles);
     }
     std::fill(start.x.begin(), start.x.end(), 5.0);
     fesd::nlp::NlpResult r;
@@ -308,14 +308,14 @@ class FailingSolver : public fesd::nlp::NlpSolver {
     r.inf_pr = feasible ? 1e-9 : inf_pr_;
     // The homotopy's answer for this failure (IPOPT's ladder asks it about the statuses it
     // retries, not Infeasible_Problem_Detected; the answer does not read the status).
-    caller_retries_failure.push_back(caller_retries && caller_retries(r) ? 1 : 0);
+    caller_handles_failure.push_back(caller_handles && caller_handles(r) ? 1 : 0);
     return r;
   }
   std::vector<std::vector<double>> starts;  ///< the primal start of every call
   std::vector<bool> warm;                   ///< warm_start of every call
   /// Per call: whether the homotopy said it retries the call's failure itself (1) or not (0);
   /// -1 for a call that did not fail.
-  std::vector<int> caller_retries_failure;
+  std::vector<int> caller_handles_failure;
 
  private:
   std::vector<int> fail_, feasible_;
@@ -458,7 +458,7 @@ TEST(HomotopyRetries, FeasibleFailureOfTheLastNlpIsRetried) {
   EXPECT_NEAR(p.at(p.x), 1.0, 2e-3);
   EXPECT_NEAR(p.at(p.y), 0.0, 2e-3);
   // The NLP solver was told so, and leaves out its linear-algebra fallbacks.
-  EXPECT_EQ(solver.caller_retries_failure, (std::vector{-1, -1, 1, -1, -1}));
+  EXPECT_EQ(solver.caller_handles_failure, (std::vector{-1, -1, 1, -1, -1}));
 
   TinyProblem q(1.0);
   FailingSolver plain({}, 1.0, /*feasible=*/{2});
@@ -467,47 +467,67 @@ TEST(HomotopyRetries, FeasibleFailureOfTheLastNlpIsRetried) {
   ASSERT_EQ(res0.rows.size(), 3u);
   EXPECT_FALSE(res0.rows[2].retried);
   EXPECT_EQ(q.at(q.x), 5.0);
-  EXPECT_EQ(plain.caller_retries_failure, (std::vector{-1, -1, 0}));  // no retry: every fallback
+  EXPECT_EQ(plain.caller_handles_failure, (std::vector{-1, -1, 0}));  // no retry: every fallback
 }
 
-// Which failures the homotopy tells the NLP solver it retries itself (nlp::CallerRetries): those
+// Which failures the homotopy tells the NLP solver it handles itself (nlp::CallerHandles): those
 // it then retries (infeasible, or the schedule's last NLP, with a converged NLP before it and
-// retries left), and no other. Calls: sigma = 0.1 (call 0), 0.01, 1e-3, ... (complementarity_tol
+// retries left) and, after a warm start, those at a feasible point that it goes on from (not the
+// schedule's last); no other. Calls: sigma = 0.1 (call 0), 0.01, 1e-3, ... (complementarity_tol
 // 1e-6).
-TEST(HomotopyRetries, TellsTheNlpSolverWhichFailuresItRetries) {
+TEST(HomotopyRetries, TellsTheNlpSolverWhichFailuresItHandles) {
   fesd::HomotopyOptions options = homotopy_down_to(1e-6, 4);
   options.homotopy_cold_restart = false;
   // The first NLP: nothing converged before it, so no retry (IPOPT keeps its whole ladder).
   TinyProblem p(1.0);
   FailingSolver first({0});
   const auto res_first = p.problem.solve_homotopy(first, options);
-  ASSERT_FALSE(first.caller_retries_failure.empty());
-  EXPECT_EQ(first.caller_retries_failure[0], 0);
+  ASSERT_FALSE(first.caller_handles_failure.empty());
+  EXPECT_EQ(first.caller_handles_failure[0], 0);
   EXPECT_FALSE(res_first.rows[0].retried);
   // An infeasible failure in the middle (call 1, sigma = 0.01): retried at 10^-1.5 (call 2),
   // whose infeasible failure is retried too (at 10^-1.25, call 3); then 0.01 (call 4) and 1e-3
-  // (call 5), whose failure ends feasible: the homotopy goes on from it, so the solver is told
-  // it is not retried.
+  // (call 5), whose failure ends feasible: the homotopy goes on from it, and the solver is told
+  // so too.
   TinyProblem q(1.0);
   FailingSolver middle({1, 2}, 1.0, /*feasible=*/{5});
   const auto res_middle = q.problem.solve_homotopy(middle, options);
-  ASSERT_GE(middle.caller_retries_failure.size(), 6u);
+  ASSERT_GE(middle.caller_handles_failure.size(), 6u);
   EXPECT_EQ(
-      std::vector(middle.caller_retries_failure.begin(), middle.caller_retries_failure.begin() + 6),
-      (std::vector{-1, 1, 1, -1, -1, 0}));
+      std::vector(middle.caller_handles_failure.begin(), middle.caller_handles_failure.begin() + 6),
+      (std::vector{-1, 1, 1, -1, -1, 1}));
   EXPECT_TRUE(res_middle.rows[1].retried);
   EXPECT_TRUE(res_middle.rows[2].retried);
   EXPECT_FALSE(res_middle.rows[5].retried);
+  ASSERT_GE(res_middle.rows.size(), 7u);
+  EXPECT_NEAR(res_middle.rows[6].sigma, 1e-4, 1e-18);  // on from the failed point
+  // A feasible failure of the first (cold) NLP: the homotopy goes on from it too, but the
+  // solver keeps its fallbacks, which cure cold NLPs.
+  TinyProblem c(1.0);
+  FailingSolver cold({}, 1.0, /*feasible=*/{0});
+  const auto res_cold = c.problem.solve_homotopy(cold, options);
+  ASSERT_FALSE(cold.caller_handles_failure.empty());
+  EXPECT_EQ(cold.caller_handles_failure[0], 0);
+  ASSERT_GE(res_cold.rows.size(), 2u);
+  EXPECT_NEAR(res_cold.rows[1].sigma, 0.01, 1e-17);
   // With the retries used up, a failure is not retried and the solver keeps its fallbacks.
   options.homotopy_retries = 1;
   TinyProblem r(1.0);
   FailingSolver spent({1, 2});
   const auto res_spent = r.problem.solve_homotopy(spent, options);
-  ASSERT_GE(spent.caller_retries_failure.size(), 3u);
-  EXPECT_EQ(spent.caller_retries_failure[1], 1);
+  ASSERT_GE(spent.caller_handles_failure.size(), 3u);
+  EXPECT_EQ(spent.caller_handles_failure[1], 1);
   EXPECT_TRUE(res_spent.rows[1].retried);
-  EXPECT_EQ(spent.caller_retries_failure[2], 0);
+  EXPECT_EQ(spent.caller_handles_failure[2], 0);
   EXPECT_FALSE(res_spent.rows[2].retried);
+  // ... unless it ends feasible in the middle of the schedule: the homotopy goes on from it.
+  TinyProblem f(1.0);
+  FailingSolver spent_feasible({1}, 1.0, /*feasible=*/{2});
+  const auto res_spent_feasible = f.problem.solve_homotopy(spent_feasible, options);
+  ASSERT_GE(spent_feasible.caller_handles_failure.size(), 3u);
+  EXPECT_EQ(spent_feasible.caller_handles_failure[1], 1);
+  EXPECT_EQ(spent_feasible.caller_handles_failure[2], 1);
+  EXPECT_FALSE(res_spent_feasible.rows[2].retried);
   // The tight re-solve at a loosely converged NLP's sigma has no smaller step to take: a failure
   // there is not retried (min (x - 1)^2 + (y + 1)^2 meets complementarity at the first NLP).
   TinyProblem t(-1.0);
@@ -518,8 +538,8 @@ TEST(HomotopyRetries, TellsTheNlpSolverWhichFailuresItRetries) {
   const auto res_tight = t.problem.solve_homotopy(tight, loose);
   ASSERT_GE(res_tight.rows.size(), 2u);
   EXPECT_EQ(res_tight.rows[1].sigma, res_tight.rows[0].sigma);
-  ASSERT_GE(tight.caller_retries_failure.size(), 2u);
-  EXPECT_EQ(tight.caller_retries_failure[1], 0);
+  ASSERT_GE(tight.caller_handles_failure.size(), 2u);
+  EXPECT_EQ(tight.caller_handles_failure[1], 0);
   EXPECT_FALSE(res_tight.rows[1].retried);
 }
 

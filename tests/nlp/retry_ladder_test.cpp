@@ -43,8 +43,8 @@ TEST(RetryLadder, StricterPivotingFactorizesWithTheFreshScaling) {
   EXPECT_TRUE(fresh_scaling_on(Rung::StricterPivoting, fresh));
 }
 
-TEST(RetryLadder, OnlyTheMuStrategyRunsBeforeTheCallersRetry) {
-  // A caller that retries the failure itself (the homotopy) gets it back after the mu strategy's
+TEST(RetryLadder, OnlyTheMuStrategyRunsBeforeTheCallerHandlesIt) {
+  // A caller that handles the failure itself (the homotopy) gets it back after the mu strategy's
   // run: the other rungs only change the linear algebra.
   EXPECT_FALSE(fesd::nlp::changes_linear_algebra_only(Rung::OtherMuStrategy));
   EXPECT_TRUE(fesd::nlp::changes_linear_algebra_only(Rung::FreshScaling));
@@ -56,11 +56,11 @@ TEST(RetryLadder, OnlyTheMuStrategyRunsBeforeTheCallersRetry) {
 struct FakeLadder {
   std::vector<Rung> ran;
   bool failed = true;
-  std::vector<Rung> run(const std::vector<Rung>& rungs, int caller_retries_from, int solved_on,
+  std::vector<Rung> run(const std::vector<Rung>& rungs, int caller_handles_from, int solved_on,
                         bool* left) {
     *left = fesd::nlp::climb(
         rungs, [&] { return failed; },
-        [&] { return static_cast<int>(ran.size()) >= caller_retries_from; },
+        [&] { return static_cast<int>(ran.size()) >= caller_handles_from; },
         [&](Rung rung) {
           ran.push_back(rung);
           failed = static_cast<int>(ran.size()) != solved_on;
@@ -69,7 +69,7 @@ struct FakeLadder {
   }
 };
 
-TEST(RetryLadder, ClimbStopsWhereTheCallerRetries) {
+TEST(RetryLadder, ClimbStopsWhereTheCallerHandles) {
   const std::vector<Rung> warm = retry_ladder({.warm_retry = true, .sparse_ldl = true});
   constexpr int kNever = 100;
   bool left = false;
