@@ -152,7 +152,11 @@ TEST(NosnocFiles, PeriodicStickSlipCodim1SticksUntilX1IsOne) {
 // gain, symmetric about t = 15; the costate p_v jumps at the crossings so that H stays
 // continuous) is J* = 5.883836 with crossings at 4.4511 and 25.5489. The discretized problem
 // restricts u to 30 constants and integrates these dynamics exactly, so J >= J*; measured
-// 5.919745 (0.6 % above; 5.88624 with 60 stages, 5.88525 with 120).
+// 5.919745 (0.6 % above; 5.88624 with 60 stages, 5.88525 with 120). The discretized problem has
+// several local minimizers, among which round-off picks: the Release build's crossing is within
+// 0.5 of 4.4511, the Debug sanitizer build's ends at J = 5.92862 (0.8 % above) with its first
+// crossing at t = 5, a stage boundary. So the crossing is asserted within one control stage
+// (T / N_stages = 1) of the continuous one.
 TEST(NosnocFiles, SimpleCarAboveTheContinuousOptimumByLessThanOnePercent) {
   const fesd::OcpProblem p = fesd::load_ocp_problem(example_path("simple_car_algebraic.toml"));
   const fesd::OcpResult r = fesd::solve(p.ocp, p.options);
@@ -163,7 +167,7 @@ TEST(NosnocFiles, SimpleCarAboveTheContinuousOptimumByLessThanOnePercent) {
   EXPECT_NEAR(r.x_final()[0], 500.0, 1e-6);
   EXPECT_NEAR(r.x_final()[1], 0.0, 1e-6);
   ASSERT_GE(r.switches.size(), 2u);
-  EXPECT_NEAR(r.switches.front().t, 4.4511, 0.5);
+  EXPECT_NEAR(r.switches.front().t, 4.4511, 1.0);
 }
 
 }  // namespace
