@@ -181,8 +181,10 @@ struct HomotopyOptions {
   /// N_homotopy). A failed NLP that ends feasible (e.g. at max_iter) is kept, and so is every
   /// failed NLP with 0: the homotopy goes on from its point, as nosnoc's does. The schedule's
   /// last NLP is retried also where it fails feasible (no NLP follows it to go on to). A failure
-  /// the homotopy retries is returned by the IPOPT backend before its scaling, pivoting and MUMPS
-  /// retries (after the mu-strategy one; docs/kkt-solver.md, "The caller's retry first").
+  /// the homotopy retries, and a warm-started NLP's failure at a feasible point that it goes on
+  /// from, are returned by the IPOPT backend before its scaling, pivoting and MUMPS retries (after
+  /// the mu-strategy one; docs/kkt-solver.md, "The caller's retry first" and "Failures the
+  /// homotopy goes on from").
   int homotopy_retries = 4;
   /// `homotopy_cold_restart` (optimal control): a homotopy that would end with a failed NLP, after
   /// an NLP that failed at a point violating the constraints with no retry left
