@@ -182,9 +182,9 @@ struct HomotopyOptions {
   /// failed NLP with 0: the homotopy goes on from its point, as nosnoc's does. The schedule's
   /// last NLP is retried also where it fails feasible (no NLP follows it to go on to). A failure
   /// the homotopy retries, and a warm-started NLP's failure at a feasible point that it goes on
-  /// from, are returned by the IPOPT backend before its scaling, pivoting and MUMPS retries (after
-  /// the mu-strategy one; docs/kkt-solver.md, "The caller's retry first" and "Failures the
-  /// homotopy goes on from").
+  /// from (in a simulation step's homotopy too), are returned by the IPOPT backend before its
+  /// scaling, pivoting and MUMPS retries (after the mu-strategy one, where there is one;
+  /// docs/kkt-solver.md, "The caller's retry first" and "Failures the homotopy goes on from").
   int homotopy_retries = 4;
   /// `homotopy_cold_restart` (optimal control): a homotopy that would end with a failed NLP, after
   /// an NLP that failed at a point violating the constraints with no retry left

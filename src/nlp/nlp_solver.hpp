@@ -50,12 +50,12 @@ struct NlpResult {
 /// step (homotopy_retries), or goes on from a failed feasible point to the next sigma. A backend
 /// then leaves out the retries that change the linear algebra (the fresh scaling, the stricter
 /// pivoting and the MUMPS fallback of nlp/retry_ladder.hpp) and returns the failure: on the
-/// hopper OCPs these cured cold NLPs only; on the last NLPs of two sweep points they failed
-/// (1081 s, 1694 s) where the smaller step then solved (60 s, 789 s; docs/kkt-solver.md, "The
-/// caller's retry first"), and on two NLPs the homotopy goes on from they failed the fresh-scaling
-/// and pivoting runs (docs/kkt-solver.md, "Failures the homotopy goes on from"). The backend asks
-/// about the last run's failure before each such retry and returns it on the first yes. Empty:
-/// the caller handles no failure.
+/// hopper OCPs, since the retry with the other mu strategy, these cured cold NLPs only; on the last
+/// NLPs of two sweep points they failed (1081 s, 1694 s) where the smaller step then solved (60 s,
+/// 789 s; docs/kkt-solver.md, "The caller's retry first"), and on two NLPs the homotopy goes on
+/// from they failed the fresh-scaling and pivoting runs (docs/kkt-solver.md, "Failures the homotopy
+/// goes on from"). The backend asks about the last run's failure before each such retry and returns
+/// it on the first yes. Empty: the caller handles no failure.
 using CallerHandles = std::function<bool(const NlpResult& failed)>;
 
 class NlpSolver {

@@ -41,11 +41,11 @@ inline std::vector<RetryRung> retry_ladder(const RetryLadderInput& in) {
 
 /// Whether a rung changes only how the KKT systems are solved (scaling, pivoting, solver), not
 /// IPOPT's path: the rungs left out when the caller handles the failure itself. Measured on the
-/// hopper sweeps (docs/kkt-solver.md, "The caller's retry first"): these rungs solved cold NLPs
-/// only; every warm-started NLP they ran on failed on all of them (the last NLPs of three sweep
-/// points, 912-1694 s per NLP) or on all that finished (two NLPs the homotopy goes on from, each
-/// stopped on its MUMPS run after 8400 and 3400 iterations: "Failures the homotopy goes on
-/// from").
+/// hopper sweeps since the monotone run (docs/kkt-solver.md, "The caller's retry first"): these
+/// rungs solved cold NLPs only; every warm-started NLP they ran on failed on all of them (the
+/// last NLPs of three sweep points, 912-1694 s per NLP) or on all that finished (two NLPs the
+/// homotopy goes on from, each stopped on its MUMPS run after four failed runs: "Failures the
+/// homotopy goes on from"). Before the monotone run, MUMPS solved warm NLPs that it now solves.
 inline bool changes_linear_algebra_only(RetryRung rung) {
   return rung != RetryRung::OtherMuStrategy;
 }

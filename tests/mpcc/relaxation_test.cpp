@@ -313,8 +313,8 @@ class FailingSolver : public fesd::nlp::NlpSolver {
   }
   std::vector<std::vector<double>> starts;  ///< the primal start of every call
   std::vector<bool> warm;                   ///< warm_start of every call
-  /// Per call: whether the homotopy said it retries the call's failure itself (1) or not (0);
-  /// -1 for a call that did not fail.
+  /// Per call: whether the homotopy said it handles the call's failure itself (1: retries it or
+  /// goes on from it) or not (0); -1 for a call that did not fail.
   std::vector<int> caller_handles_failure;
 
  private:
@@ -501,6 +501,7 @@ TEST(HomotopyRetries, TellsTheNlpSolverWhichFailuresItHandles) {
   EXPECT_FALSE(res_middle.rows[5].retried);
   ASSERT_GE(res_middle.rows.size(), 7u);
   EXPECT_NEAR(res_middle.rows[6].sigma, 1e-4, 1e-18);  // on from the failed point
+  EXPECT_EQ(middle.starts[6][q.x], 5.0);
   // A feasible failure of the first (cold) NLP: the homotopy goes on from it too, but the
   // solver keeps its fallbacks, which cure cold NLPs.
   TinyProblem c(1.0);
@@ -520,7 +521,9 @@ TEST(HomotopyRetries, TellsTheNlpSolverWhichFailuresItHandles) {
   EXPECT_TRUE(res_spent.rows[1].retried);
   EXPECT_EQ(spent.caller_handles_failure[2], 0);
   EXPECT_FALSE(res_spent.rows[2].retried);
-  // ... unless it ends feasible in the middle of the schedule: the homotopy goes on from it.
+  // ... unless it ends feasible and is not the schedule's last: the homotopy goes on from it.
+  // Here the retry step itself (10^-1.5, call 2) fails so, and the homotopy goes on from its
+  // point to 0.01.
   TinyProblem f(1.0);
   FailingSolver spent_feasible({1}, 1.0, /*feasible=*/{2});
   const auto res_spent_feasible = f.problem.solve_homotopy(spent_feasible, options);
@@ -528,6 +531,9 @@ TEST(HomotopyRetries, TellsTheNlpSolverWhichFailuresItHandles) {
   EXPECT_EQ(spent_feasible.caller_handles_failure[1], 1);
   EXPECT_EQ(spent_feasible.caller_handles_failure[2], 1);
   EXPECT_FALSE(res_spent_feasible.rows[2].retried);
+  ASSERT_GE(res_spent_feasible.rows.size(), 4u);
+  EXPECT_NEAR(res_spent_feasible.rows[3].sigma, 0.01, 1e-17);
+  EXPECT_EQ(spent_feasible.starts[3][f.x], 5.0);
   // The tight re-solve at a loosely converged NLP's sigma has no smaller step to take: a failure
   // there is not retried (min (x - 1)^2 + (y + 1)^2 meets complementarity at the first NLP).
   TinyProblem t(-1.0);
@@ -541,6 +547,29 @@ TEST(HomotopyRetries, TellsTheNlpSolverWhichFailuresItHandles) {
   ASSERT_GE(tight.caller_handles_failure.size(), 2u);
   EXPECT_EQ(tight.caller_handles_failure[1], 0);
   EXPECT_FALSE(res_tight.rows[1].retried);
+  // A feasible failure there, with NLPs left in the schedule: the homotopy goes on from it to the
+  // next sigma, so the solver is told it handles it.
+  TinyProblem tf(-1.0);
+  FailingSolver tight_feasible({}, 1.0, /*feasible=*/{1});
+  const auto res_tight_feasible = tf.problem.solve_homotopy(tight_feasible, loose);
+  ASSERT_GE(res_tight_feasible.rows.size(), 3u);
+  EXPECT_EQ(res_tight_feasible.rows[1].sigma, res_tight_feasible.rows[0].sigma);
+  ASSERT_GE(tight_feasible.caller_handles_failure.size(), 2u);
+  EXPECT_EQ(tight_feasible.caller_handles_failure[1], 1);
+  EXPECT_NEAR(res_tight_feasible.rows[2].sigma, 0.01, 1e-17);
+  // The cold restart's NLP (from the initial guess, without multipliers) keeps the solver's
+  // fallbacks even where it fails feasible: sigma = 0.1, 0.01, 1e-3, 1e-4 without retries; 1e-3
+  // and 1e-4 fail infeasible (not retried: the solver keeps its fallbacks), the restart at 1e-3
+  // (call 4) fails feasible.
+  TinyProblem cr(1.0);
+  FailingSolver restart({2, 3}, 1.0, /*feasible=*/{4});
+  const auto res_restart = cr.problem.solve_homotopy(restart, homotopy_down_to(1e-4, 0));
+  ASSERT_GE(res_restart.rows.size(), 5u);
+  EXPECT_TRUE(res_restart.rows[4].cold_start);
+  ASSERT_GE(restart.caller_handles_failure.size(), 5u);
+  EXPECT_EQ(std::vector(restart.caller_handles_failure.begin(),
+                        restart.caller_handles_failure.begin() + 5),
+            (std::vector{-1, -1, 0, 0, 0}));
 }
 
 // sigma = 0.1, 0.01, 1e-3, 1e-4 (complementarity_tol 1e-4), no retries. The NLPs at 1e-3 and 1e-4

@@ -73,7 +73,7 @@ TEST(RetryLadder, ClimbStopsWhereTheCallerHandles) {
   const std::vector<Rung> warm = retry_ladder({.warm_retry = true, .sparse_ldl = true});
   constexpr int kNever = 100;
   bool left = false;
-  // The caller retries every failure: only the mu strategy's run, then back to the caller.
+  // The caller handles every failure: only the mu strategy's run, then back to the caller.
   EXPECT_EQ(FakeLadder{}.run(warm, 0, kNever, &left), (std::vector{Rung::OtherMuStrategy}));
   EXPECT_TRUE(left);
   // It does not: every rung.
@@ -83,8 +83,9 @@ TEST(RetryLadder, ClimbStopsWhereTheCallerHandles) {
   EXPECT_EQ(FakeLadder{}.run(warm, kNever, 2, &left),
             (std::vector{Rung::OtherMuStrategy, Rung::FreshScaling}));
   EXPECT_FALSE(left);
-  // Asked again before each rung about the last run's failure: a caller that retries only the
-  // failure of the second run (e.g. one that ended infeasible) gets it back there.
+  // Asked again before each rung about the last run's failure: a caller that handles only the
+  // failure of the second run (e.g. the homotopy, with its retries spent, where only that run ends
+  // at a feasible point it goes on from) gets it back there.
   EXPECT_EQ(FakeLadder{}.run(warm, 2, kNever, &left),
             (std::vector{Rung::OtherMuStrategy, Rung::FreshScaling}));
   EXPECT_TRUE(left);
