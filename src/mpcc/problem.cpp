@@ -226,7 +226,8 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
       // The failures of a warm-started NLP that the homotopy handles itself: those it retries,
       // and those at a feasible point that it goes on from (not the schedule's last). The NLP
       // solver asks, and returns them before its linear-algebra fallbacks (nlp::CallerHandles).
-      // The first NLP and a cold restart keep every fallback: only there did they cure an NLP.
+      // The first NLP and a cold restart keep every fallback: only there did they cure an NLP
+      // since the monotone retry (docs/kkt-solver.md, "Failures the homotopy goes on from").
       const auto handled_here = [&](const nlp::NlpResult& f) {
         return retried_here(f) || (warm && !f.success && !unusable(f) && !ends_schedule);
       };
