@@ -249,11 +249,13 @@ TEST(ActiveSetSliding, CodimensionTwoInACartesianProduct) {
 // (sliding_is_filippov); those steps fall back to the homotopy, whose relaxed homotopy (sigma_N
 // = 1e-2) carries the state over the equilibrium. The file's complementarity_tol is 1e-2: the
 // homotopy path's exact re-solves leave its switch at 2.6 3.9e-7 early (its element starts
-// sliding at w = 1 - 9.8e-7), so the paths agree to 1e-6 in the switch times, 1e-7 in x(T).
+// sliding at w = 1 - 9.8e-7), so the paths agree to 1e-6 in the switch times and in x(T): x(T)
+// differs by that offset times the state's speed, below 1e-7 in the Release build and 3.86e-7 in
+// the Debug sanitizer build (round-off moves where in the offset's range the two paths end).
 TEST(ActiveSetSliding, TemperatureControlSameAsHomotopy) {
   const Both b = run_file("nosnoc/temperature_control.toml");
   expect_same(b, 1e-6);
-  EXPECT_LT((b.active.x_final() - b.homotopy.x_final()).lpNorm<Eigen::Infinity>(), 1e-7);
+  EXPECT_LT((b.active.x_final() - b.homotopy.x_final()).lpNorm<Eigen::Infinity>(), 1e-6);
   ASSERT_EQ(b.active.switches.size(), 7u);
   EXPECT_NEAR(b.active.switches[1].t, 0.5, 1e-9);
   EXPECT_GE(b.active.summary.active_set_path_steps, 25);
