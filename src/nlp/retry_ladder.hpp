@@ -45,7 +45,8 @@ inline std::vector<RetryRung> retry_ladder(const RetryLadderInput& in) {
 /// rungs solved cold NLPs only; every warm-started NLP they ran on failed on all of them (the
 /// last NLPs of three sweep points, 912-1694 s per NLP) or on all that finished (two NLPs the
 /// homotopy goes on from, each stopped on its MUMPS run after four failed runs: "Failures the
-/// homotopy goes on from"). Before the monotone run, MUMPS solved warm NLPs that it now solves.
+/// homotopy goes on from"). Before the monotone run, MUMPS solved warm NLPs that the
+/// monotone run now solves.
 inline bool changes_linear_algebra_only(RetryRung rung) {
   return rung != RetryRung::OtherMuStrategy;
 }
