@@ -47,10 +47,14 @@ struct HomotopyRow {
   /// The NLP failed and its point was discarded: the homotopy went back to the last converged
   /// NLP and took a smaller sigma step (HomotopyOptions::homotopy_retries).
   bool retried = false;
-  /// Part of a path that ended with a failed NLP and was replaced by the cold restart
-  /// (HomotopyOptions::homotopy_cold_restart): from the first NLP that failed at a point violating
-  /// the constraints with no retry left, to the end of that path.
+  /// Part of a path that ended with a failed NLP (or a stalled penalty) and was replaced by the
+  /// cold restart (HomotopyOptions::homotopy_cold_restart): from the first NLP that failed at a
+  /// point violating the constraints with no retry left, or that stalled, to the end of that path.
   bool restarted = false;
+  /// A penalty mode's NLP (ell_1_penalty, elastic_*) that converged with the complementarity
+  /// residual above half that of its start although sigma fell: a stationary point of the penalty,
+  /// where the cold restart starts if the homotopy ends with the residual still there.
+  bool stalled = false;
   /// The NLP started from the initial guess instead of the NLP before it: the cold restart, at
   /// the sigma of the first `restarted` row.
   bool cold_start = false;

@@ -149,6 +149,7 @@ py::dict homotopy_row(const fesd::HomotopyRow& r) {
   d["pinned_exits"] = r.pinned_exits;
   d["retried"] = r.retried;
   d["restarted"] = r.restarted;
+  d["stalled"] = r.stalled;
   d["cold_start"] = r.cold_start;
   return d;
 }

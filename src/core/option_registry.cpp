@@ -385,7 +385,9 @@ std::vector<Option> build() {
       between(0, 100, "(0: go on from the failed point)")));
   o.push_back(scalar<&T::homotopy, &H::homotopy_cold_restart>(
       kHom, "homotopy_cold_restart", Use::Ocp,
-      "once the retries are used up, solve a failed NLP again from the initial guess", ""));
+      "once the retries are used up, solve a failed (or stalled penalty) NLP again from the "
+      "initial guess",
+      ""));
   o.push_back(scalar<&T::homotopy, &H::intermediate_tol>(
       kHom, "intermediate_tol", kBoth, "IPOPT tol of the NLPs with sigma > 10 complementarity_tol",
       "", Range{.min = 0, .note = "(0: ipopt.tol everywhere)"}));

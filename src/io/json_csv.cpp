@@ -145,6 +145,7 @@ json homotopy_row(const HomotopyRow& r) {
               {"pinned_exits", r.pinned_exits},
               {"retried", r.retried},
               {"restarted", r.restarted},
+              {"stalled", r.stalled},
               {"cold_start", r.cold_start}};
 }
 

@@ -28,6 +28,17 @@ bool unusable(const nlp::NlpResult& r) {
   return r.eval_error || !(r.inf_pr <= kFeasibleFailure);
 }
 
+// The penalty modes: sigma weighs a penalty term (1 / sigma) P instead of bounding each product,
+// so the complementarity residual is not held below sigma and can stall (homotopy_cold_restart).
+bool penalty_mode(MpccMode m) {
+  return m == MpccMode::ElasticIneq || m == MpccMode::ElasticTwoSided || m == MpccMode::L1Penalty;
+}
+
+// A converged NLP of a penalty mode whose complementarity residual is more than this fraction of
+// the residual of the point it started from, although sigma fell, has stalled: its point is a
+// stationary point of the penalty (docs/formulation.md, "A stalled penalty").
+constexpr double kStallRatio = 0.5;
+
 // Adds the row of one NLP solve (k, sigma) to res and its times and iterations to the totals.
 void record(HomotopyResult& res, const nlp::NlpResult& r, int k, double sigma) {
   // r.objective is the NLP's objective: in the penalty modes (ell_1_penalty, elastic_*) it
@@ -90,13 +101,23 @@ void append(HomotopyResult& to, const HomotopyResult& from) {
 }
 
 std::string cold_restart_warning(const HomotopyResult& h) {
-  for (const HomotopyRow& r : h.rows)
-    if (r.cold_start)
-      return fmt::format(
-          "the homotopy ended failed after the NLP at sigma = {:.3g} had failed (after the "
-          "retries), so it started again there from the initial guess (homotopy_cold_restart): "
-          "the result is the minimizer that start leads to, not a continuation of the first NLPs",
-          r.sigma);
+  bool stalled = false;
+  for (const HomotopyRow& r : h.rows) {
+    if (r.restarted && r.stalled) stalled = true;
+    if (!r.cold_start) continue;
+    const std::string why =
+        stalled ? fmt::format(
+                      "the homotopy ended with the complementarity residual stalled since the NLP "
+                      "at sigma = {:.3g} (a stationary point of the penalty)",
+                      r.sigma)
+                : fmt::format(
+                      "the homotopy ended failed after the NLP at sigma = {:.3g} had failed "
+                      "(after the retries)",
+                      r.sigma);
+    return why +
+           ", so it started again there from the initial guess (homotopy_cold_restart): the "
+           "result is the minimizer that start leads to, not a continuation of the first NLPs";
+  }
   return {};
 }
 
@@ -183,14 +204,21 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
   // twice from one point.
   double sigma_retried = 0;
   // homotopy_cold_restart: the first NLP that failed at a point violating the constraints with
-  // no retry left (its row, the schedule's sigma it was heading to, and the NLPs counted then);
-  // if the homotopy ends with a failed NLP, it starts again there from the initial guess, once.
+  // no retry left, or (penalty modes) whose residual stalled (its row, the schedule's sigma it was
+  // heading to, the NLPs counted then, and the stalled residual, else 0); if the homotopy ends
+  // with a failed NLP, or with the residual still stalled, it starts again there from the initial
+  // guess, once.
   struct ColdStart {
     int row = -1;
     double sigma = 0;
     int scheduled = 0;
+    double stalled_residual = 0;
   };
   std::optional<ColdStart> cold;
+  const bool penalty = penalty_mode(relaxation_->mode());
+  // The complementarity residual and sigma of the point the next NLP starts from (residual < 0:
+  // the initial guess), and those of `good`.
+  double start_residual = -1, start_sigma = 0, good_residual = -1;
   bool cold_restarted = false, cold_now = false;
   bool last_ok = false, eval_failed = false;
   bool tight_now = false;  // solve the next NLP with the configured tolerance
@@ -248,6 +276,8 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
         if (on_row) on_row(res.rows.back());
         ++retries;
         it_ = *good;
+        start_residual = good_residual;
+        start_sigma = sigma_good;
         // (A retry that ended feasible but failed is kept, and the failed sigma after it would
         // otherwise send the next retry to that same sigma again.)
         sigma = std::sqrt(sigma_good * std::max(sigma, sigma_retried));
@@ -258,11 +288,23 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
       // the cold restart would start if it ends failed (the first such NLP: `cold` stays set
       // after the restart too).
       if (!last_ok && unusable(r) && k > 0 && !cold) cold = ColdStart{k, target, scheduled};
+      // A stalled penalty: the NLP converged, sigma fell (its weight 1 / sigma grew), and the
+      // residual did not fall to half that of its start: the point is a stationary point of the
+      // penalty, and the NLPs after it usually end there too (docs/formulation.md).
+      if (last_ok && penalty && !cold && start_residual > 0 && sigma < start_sigma &&
+          res.comp_residual > o.complementarity_tol &&
+          res.comp_residual > kStallRatio * start_residual) {
+        cold = ColdStart{k, target, scheduled, res.comp_residual};
+        res.rows.back().stalled = true;
+      }
+      start_residual = res.comp_residual;
+      start_sigma = sigma;
       if (on_row) on_row(res.rows.back());
       if (on_schedule) ++scheduled;
       if (last_ok && o.homotopy_retries > 0) {  // (no copy when nothing can be retried)
         good = it_;
         sigma_good = sigma;
+        good_residual = res.comp_residual;
         sigma_retried = 0;
       }
       if (last_ok && res.comp_residual <= o.complementarity_tol) {
@@ -287,14 +329,20 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
     // homotopy_cold_restart: a homotopy that would end with a failed NLP, after one that failed at
     // a point violating the constraints with no retry left, solves that NLP's sigma again from the
     // initial guess (without multipliers: IPOPT's cold start) and goes on from there, once. The
-    // rows from that failure on are marked `restarted`.
-    if (!last_ok && cold && o.homotopy_cold_restart && !cold_restarted) {
+    // rows from that failure on are marked `restarted`. The same after a stalled penalty, when
+    // the homotopy would end failed or with the residual above complementarity_tol and still
+    // above half the stalled one.
+    const bool still_stalled = cold && cold->stalled_residual > 0 &&
+                               res.comp_residual > o.complementarity_tol &&
+                               res.comp_residual > kStallRatio * cold->stalled_residual;
+    if ((!last_ok || still_stalled) && cold && o.homotopy_cold_restart && !cold_restarted) {
       for (std::size_t i = static_cast<std::size_t>(cold->row); i < res.rows.size(); ++i)
         res.rows[i].restarted = true;
       cold_restarted = cold_now = true;
       it_ = nlp::Iterate{};
       it_.x = nlp_.x_init;
       good.reset();
+      start_residual = -1;
       sigma = target = cold->sigma;
       scheduled = cold->scheduled;
       tight_now = false;

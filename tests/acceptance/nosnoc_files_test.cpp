@@ -289,10 +289,9 @@ fesd::OcpProblem uncontrolled_ball(std::string_view key, std::string_view value)
 }
 }  // namespace
 
-TEST(NosnocFiles, ElasticBallWithoutControlBouncesOffTheTopWall) {
-  const fesd::OcpProblem p = uncontrolled_ball("initialization", "simulation");
-  const fesd::OcpResult r = fesd::solve(p.ocp, p.options);
-  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+namespace {
+/// The checks of the bounce in closed form on a solution `r` of uncontrolled_ball `p`.
+void expect_closed_form_bounce(const fesd::OcpProblem& p, const fesd::OcpResult& r) {
   const Eigen::VectorXd x0 = p.ocp.x0;
   const double b_top = 1.15, k = 100.0, T = 0.1;
   const double t_imp = (b_top - x0[1]) / x0[3];
@@ -333,13 +332,48 @@ TEST(NosnocFiles, ElasticBallWithoutControlBouncesOffTheTopWall) {
   EXPECT_LT(-xT[3], x0[3]);
   EXPECT_GT(-xT[3], 0.8 * x0[3]);
 }
+}  // namespace
+
+TEST(NosnocFiles, ElasticBallWithoutControlBouncesOffTheTopWall) {
+  const fesd::OcpProblem p = uncontrolled_ball("initialization", "simulation");
+  const fesd::OcpResult r = fesd::solve(p.ocp, p.options);
+  ASSERT_EQ(r.status, fesd::Status::Success) << r.message;
+  expect_closed_form_bounce(p, r);
+}
+
+// From the constant guess the elastic variable stalls: the residual stays at 0.264 from sigma =
+// 0.01 on while the weight 1 / sigma grows (a stationary point of the penalty). The homotopy then
+// starts again at that sigma from the initial guess (homotopy_cold_restart, docs/formulation.md
+// "A stalled penalty"), once; this initial guess leads to the same point, so it ends
+// complementarity_not_met there and says so. (The simulation guess of the test above avoids it.)
+TEST(NosnocFiles, ElasticBallFromTheConstantGuessStallsAndRestartsOnce) {
+  const fesd::OcpProblem p = uncontrolled_ball("N_homotopy", "5");
+  const fesd::OcpResult r = fesd::solve(p.ocp, p.options);
+  EXPECT_EQ(r.status, fesd::Status::ComplementarityNotMet) << r.message;
+  int stalled = -1, cold = -1, colds = 0;
+  for (std::size_t k = 0; k < r.homotopy.size(); ++k) {
+    if (r.homotopy[k].stalled && stalled < 0) stalled = static_cast<int>(k);
+    if (r.homotopy[k].cold_start) cold = static_cast<int>(k), ++colds;
+  }
+  ASSERT_EQ(stalled, 1);
+  EXPECT_NEAR(r.homotopy[1].comp_residual, 0.264, 5e-4);
+  EXPECT_EQ(colds, 1);
+  ASSERT_GT(cold, stalled);
+  EXPECT_EQ(r.homotopy[cold].sigma, r.homotopy[stalled].sigma);
+  EXPECT_NEAR(r.comp_residual, 0.264, 5e-4);
+  bool warned = false;
+  for (const std::string& w : r.summary.warnings)
+    warned = warned || w.find("stalled since the NLP at sigma = 0.01") != std::string::npos;
+  EXPECT_TRUE(warned);
+}
 
 // The status of a homotopy whose last NLP is followed by a failed re-solve with the active sets
 // fixed (active_set_sigma): that re-solve is discarded, so the result is the last NLP's, with its
 // residual. (It used to report success: the discarded point's residual, 0 by construction, was
 // taken.) The ball of the test above from the constant guess, with the homotopy cut at 5 NLPs.
 TEST(NosnocFiles, FailedFixedActiveSetResolveKeepsTheResidual) {
-  const fesd::OcpProblem p = uncontrolled_ball("N_homotopy", "5");
+  fesd::OcpProblem p = uncontrolled_ball("N_homotopy", "5");
+  p.options.homotopy.homotopy_cold_restart = false;  // (the stall's restart would solve it)
   const fesd::OcpResult r = fesd::solve(p.ocp, p.options);
   ASSERT_GE(r.homotopy.size(), 6u);
   EXPECT_TRUE(r.homotopy.back().active_set_fixed);

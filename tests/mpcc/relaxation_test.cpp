@@ -4,6 +4,7 @@
 // with a common factor.
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <memory>
 #include <string>
 #include <utility>
@@ -182,13 +183,13 @@ class RecordingSolver : public fesd::nlp::NlpSolver {
 struct TinyProblem {
   fesd::mpcc::Problem problem;
   int x = 0, y = 0;
-  explicit TinyProblem(double a) {
+  explicit TinyProblem(double a, MpccMode mode = MpccMode::ScholtesIneq) {
     const fesd::mpcc::CompPair xy = add_tiny_mpcc(problem.nlp(), a);
     x = xy.a;
     y = xy.b;
     const std::vector<fesd::mpcc::CompPair> pairs{{x, y}};
     problem.add_complementarity({fesd::mpcc::CompGroup{pairs}}, pairs);
-    problem.relax(MpccMode::ScholtesIneq);
+    problem.relax(mode);
     problem.finalize();
   }
   /// The homotopy sigma = 0.1, 0.01, ... with intermediate_tol 1e-6, from (0.9, 0.2).
@@ -666,6 +667,112 @@ TEST(HomotopyColdRestart, AfterTheRetriesAtTheSchedulesSigmaOnce) {
   EXPECT_EQ(cold, 1);
   EXPECT_TRUE(res_all.rows[1].restarted);
   EXPECT_NEAR(res_all.rows[1].sigma, 0.01, 1e-17);
+}
+
+// An NLP solver that reports given calls as converged (Solve_Succeeded) at a given point (x, y)
+// of TinyProblem, and solves the others: a penalty NLP that ends at a stationary point of its
+// penalty, with the complementarity residual x y.
+class StallingSolver : public fesd::nlp::NlpSolver {
+ public:
+  StallingSolver(int x, int y, std::map<int, std::pair<double, double>> points)
+      : x_(x), y_(y), points_(std::move(points)) {}
+  fesd::nlp::NlpResult solve(const fesd::nlp::BlockNlp& nlp, fesd::nlp::Iterate& start,
+                             bool warm_start, double tol, int max_iter,
+                             const fesd::nlp::CallerHandles& caller_handles) override {
+    starts.push_back(start.x);
+    warm.push_back(warm_start);
+    const auto it = points_.find(calls_++);
+    if (it == points_.end())
+      return inner_->solve(nlp, start, warm_start, tol, max_iter, caller_handles);
+    start.x[x_] = it->second.first;
+    start.x[y_] = it->second.second;
+    fesd::nlp::NlpResult r;
+    r.success = true;
+    r.status = "Solve_Succeeded";
+    return r;
+  }
+  std::vector<std::vector<double>> starts;  ///< the primal start of every call
+  std::vector<bool> warm;                   ///< warm_start of every call
+
+ private:
+  int x_, y_;
+  std::map<int, std::pair<double, double>> points_;
+  int calls_ = 0;
+  std::unique_ptr<fesd::nlp::NlpSolver> inner_ = fesd::nlp::make_solver(fesd::NlpOptions{});
+};
+
+// A stalled penalty (docs/formulation.md, "A stalled penalty"): elastic_ineq, sigma = 0.1, 0.01,
+// 1e-3, 1e-4 (complementarity_tol 1e-4). The first NLP ends with the residual 0.4, those at
+// 0.01, 1e-3 and 1e-4 at the same point with 0.21, more than half that of their start although
+// the weight 1 / sigma grew: the homotopy would end complementarity_not_met there, so it starts
+// again at 0.01 (the first stalled NLP) from the initial guess and reaches the MPCC's solution
+// (1, 0). Without the option: complementarity_not_met at 0.21.
+TEST(HomotopyColdRestart, StalledPenaltyStartsAgainFromTheInitialGuess) {
+  fesd::HomotopyOptions options = homotopy_down_to(1e-4, 0);
+  TinyProblem p(1.0, MpccMode::ElasticIneq);
+  const std::pair<double, double> stuck{0.5, 0.42};
+  StallingSolver solver(p.x, p.y, {{0, {0.5, 0.8}}, {1, stuck}, {2, stuck}, {3, stuck}});
+  const auto res = p.problem.solve_homotopy(solver, options);
+  ASSERT_EQ(res.status, fesd::Status::Success) << res.last_nlp_status;
+  ASSERT_GE(res.rows.size(), 5u);
+  EXPECT_NEAR(res.rows[1].comp_residual, 0.21, 1e-15);
+  EXPECT_NEAR(res.rows[4].sigma, 0.01, 1e-17);
+  EXPECT_FALSE(solver.warm[4]);
+  EXPECT_EQ(solver.starts[4][p.x], solver.starts[0][p.x]);  // the initial guess
+  EXPECT_EQ(solver.starts[4][p.y], solver.starts[0][p.y]);
+  for (std::size_t k = 0; k < res.rows.size(); ++k) {
+    EXPECT_EQ(res.rows[k].stalled, k == 1) << "row " << k;  // the first stall only
+    EXPECT_EQ(res.rows[k].restarted, k >= 1 && k <= 3) << "row " << k;
+    EXPECT_EQ(res.rows[k].cold_start, k == 4) << "row " << k;
+  }
+  EXPECT_NEAR(p.at(p.x), 1.0, 1e-4);
+  EXPECT_NEAR(p.at(p.y), 0.0, 1e-4);
+  const std::string w = fesd::mpcc::cold_restart_warning(res);
+  EXPECT_NE(w.find("stalled since the NLP at sigma = 0.01"), std::string::npos) << w;
+
+  options.homotopy_cold_restart = false;
+  TinyProblem q(1.0, MpccMode::ElasticIneq);
+  StallingSolver plain(q.x, q.y, {{0, {0.5, 0.8}}, {1, stuck}, {2, stuck}, {3, stuck}});
+  const auto res0 = q.problem.solve_homotopy(plain, options);
+  EXPECT_EQ(res0.status, fesd::Status::ComplementarityNotMet);
+  ASSERT_EQ(res0.rows.size(), 4u);
+  EXPECT_TRUE(res0.rows[1].stalled);
+  for (const fesd::HomotopyRow& r : res0.rows) EXPECT_FALSE(r.cold_start || r.restarted);
+  EXPECT_TRUE(fesd::mpcc::cold_restart_warning(res0).empty());
+}
+
+// What a stall is: the residual of a converged penalty NLP above half that of the point it
+// started from, sigma having fallen. 0.4 -> 0.19 is not one (less than half), 0.19 -> 0.18 is;
+// the restart goes to that NLP's sigma (1e-3). (The first NLP is given too: the real one meets
+// complementarity at once.) In the Scholtes modes sigma bounds every product,
+// so the same points are no stall: complementarity_not_met, no restart. A stall the homotopy
+// recovers from (the next NLP solves) changes nothing.
+TEST(HomotopyColdRestart, StallIsAResidualAboveHalfItsStart) {
+  const fesd::HomotopyOptions options = homotopy_down_to(1e-4, 0);
+  const std::map<int, std::pair<double, double>> points{
+      {0, {0.5, 0.8}}, {1, {0.5, 0.38}}, {2, {0.5, 0.36}}, {3, {0.5, 0.36}}};
+  TinyProblem p(1.0, MpccMode::ElasticIneq);
+  StallingSolver solver(p.x, p.y, points);
+  const auto res = p.problem.solve_homotopy(solver, options);
+  ASSERT_EQ(res.status, fesd::Status::Success) << res.last_nlp_status;
+  ASSERT_GE(res.rows.size(), 5u);
+  EXPECT_FALSE(res.rows[1].stalled);
+  EXPECT_TRUE(res.rows[2].stalled);
+  EXPECT_TRUE(res.rows[4].cold_start);
+  EXPECT_NEAR(res.rows[4].sigma, 1e-3, 1e-18);
+
+  TinyProblem s(1.0, MpccMode::ScholtesIneq);
+  StallingSolver scholtes(s.x, s.y, points);
+  const auto res_s = s.problem.solve_homotopy(scholtes, options);
+  EXPECT_EQ(res_s.status, fesd::Status::ComplementarityNotMet);
+  for (const fesd::HomotopyRow& r : res_s.rows) EXPECT_FALSE(r.stalled || r.cold_start);
+
+  TinyProblem q(1.0, MpccMode::ElasticIneq);
+  StallingSolver recovers(q.x, q.y, {{0, {0.5, 0.8}}, {1, {0.5, 0.42}}});
+  const auto res_q = q.problem.solve_homotopy(recovers, options);
+  ASSERT_EQ(res_q.status, fesd::Status::Success) << res_q.last_nlp_status;
+  EXPECT_TRUE(res_q.rows[1].stalled);
+  for (const fesd::HomotopyRow& r : res_q.rows) EXPECT_FALSE(r.cold_start || r.restarted);
 }
 
 // ---- Example 3(a) through the integrator ------------------------------------------------------
