@@ -12,7 +12,7 @@ theta and lambda, phase planes, the hysteresis plane, ...).
     scripts/nosnoc_figures.py --reuse          # redraw from the JSON of an earlier run
 
 The JSON and fesd's raw plots go to build/nosnoc_figures/. The long rows (8, 10, 11, 24) are
-not run here; rows 10, 30 and 31 only with --long (docs/nosnoc-figures.md says why). Needs python3-matplotlib and Pillow
+not run here; rows 10, 23, 30 and 31 only with --long (docs/nosnoc-figures.md says why). Needs python3-matplotlib and Pillow
 (hence /usr/bin/python3).
 """
 import argparse
@@ -485,6 +485,56 @@ def fig_gearbox_3d():
                    points, extra_axis=line_3d)
 
 
+# ---- row 23 (opt-in, --long: 240 s): the elastic ball in a box -------------------------------
+def fig_elastic_ball():
+    d = run("solve", "elastic_ball_in_box", limit=1800)
+    t, x = boundaries(d), arr(d, "x")
+    clock = x[:, 4]
+    # The script plots the points of the elements in free flight (theta of the interior > 0.1):
+    # the wall regions freeze the clock, and their states are the auxiliary dynamics'.
+    flight = np.concatenate([[True], [0 in a for a in d["active_set"]]])
+    omega, a0, R = -3.0 * np.pi, np.pi / 4.0, 1.0
+    tt = np.linspace(0.0, clock[-1], 400)
+    ref_q = R * np.sin(omega * tt + a0), R * np.cos(omega * tt + a0)
+    ref_v = R * omega * np.cos(omega * tt + a0), -R * omega * np.sin(omega * tt + a0)
+    fig, axes = plt.subplots(2, 2, figsize=FIGSIZE)
+    ax = axes[0, 0]
+    ax.plot(ref_q[0], ref_q[1], "r--", linewidth=0.8, label="reference")
+    ax.plot(x[:, 0], x[:, 1], color="0.7", linewidth=0.8, label="in a wall (clock frozen)")
+    ax.plot(np.where(flight, x[:, 0], np.nan), np.where(flight, x[:, 1], np.nan), "b",
+            label="flight")
+    left, right, bottom, top = -1.2, 1.1, -1.05, 1.15  # the walls
+    ax.plot([left, right, right, left, left], [bottom, bottom, top, top, bottom], "k", linewidth=1)
+    ax.set_aspect("equal")
+    ax.set_xlabel("qx")
+    ax.set_ylabel("qy")
+    ax.legend(fontsize=6, loc="lower left")
+    for ax, (i, j), ref, name in ((axes[0, 1], (0, 1), ref_q, "q"),
+                                  (axes[1, 0], (2, 3), ref_v, "v")):
+        for k, c in ((i, "b"), (j, "r")):
+            ax.plot(clock[flight], x[flight, k], c, marker=".", markersize=2,
+                    label=d["state_names"][k])
+        ax.plot(tt, ref[0], "b:", tt, ref[1], "r:")
+        ax.set_xlabel("physical time t (clock)")
+        ax.set_ylabel(name + " (dotted: reference)")
+        ax.legend(fontsize=7)
+    ax = axes[1, 1]
+    control_steps(ax, d, 0, "ux")
+    control_steps(ax, d, 1, "uy")
+    u = arr(d, "u")
+    norm = np.hypot(u[:, 0], u[:, 1])
+    ax.step(arr(d, "t_ctrl"), np.concatenate([norm, norm[-1:]]), where="post",
+            color="0.5", linewidth=0.8, label="|u| (<= 50)")
+    ax.set_xlabel("t")
+    ax.legend(fontsize=7)
+    for a in axes.flat:
+        a.grid(True)
+    impacts = sum(1 for sw in d["switches"] if sw["before"] == [0])
+    save(fig, "elastic_ball_in_box",
+         f"elastic_ball_in_box.toml: {d['status']}, objective {d['objective']:.4f}, "
+         f"{impacts} wall contacts")
+
+
 FIGURES = {
     "simplest": fig_simplest,
     "parametric": fig_parametric,
@@ -503,7 +553,8 @@ FIGURES = {
     "car_control": fig_car_control,
     "hysteresis_car": fig_hysteresis_car,
 }
-LONG = {"irma": fig_irma, "gearbox_2d": fig_gearbox_2d, "gearbox_3d": fig_gearbox_3d}
+LONG = {"irma": fig_irma, "elastic_ball": fig_elastic_ball, "gearbox_2d": fig_gearbox_2d,
+        "gearbox_3d": fig_gearbox_3d}
 
 
 def main():
