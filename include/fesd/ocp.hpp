@@ -276,6 +276,12 @@ struct OcpOptions {
 /// Empty if valid, else one line per broken rule.
 std::vector<std::string> validate(const OcpOptions& o);
 
+/// Warnings about the formulation of a valid `ocp` (empty if none; solve() adds them to the
+/// summary). time_freezing whose clock state has the same rate in every region at x0 and the first
+/// control guess (within lbu, ubu): no region freezes it, and the clock constraints then fix that
+/// rate on every control interval (nosnoc_py's discs, docs/nosnoc-examples.md row 22).
+std::vector<std::string> warnings(const Ocp& ocp);
+
 /// The solution of an OCP. Grid = all finite-element boundaries of all control intervals.
 struct OcpResult {
   Status status = Status::NotRun;

@@ -471,6 +471,7 @@ void print_header(const fesd::OcpProblem& problem) {
     if (ocp.u_guess.size() > 0)
       out::print("  u guess     {}\n", join_vector(ocp.u_guess, ocp.model.control_names));
   }
+  for (const std::string& w : fesd::warnings(ocp)) out::print("  warning     {}\n", w);
   flush_stdout();
 }
 

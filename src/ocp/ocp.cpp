@@ -740,6 +740,7 @@ OcpResult solve_impl(const Ocp& user, const OcpOptions& options, const std::vect
   mp.finalize();
   res.summary.warnings = warnings(options.homotopy);
   for (auto& w : nlp::warnings(options.nlp)) res.summary.warnings.push_back(std::move(w));
+  for (auto& w : warnings(user)) res.summary.warnings.push_back(std::move(w));
   res.summary.n_variables = mp.num_variables();
   res.summary.n_constraints = mp.num_constraints();
   res.summary.setup_s = seconds_since(t_start);

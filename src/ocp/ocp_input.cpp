@@ -352,3 +352,50 @@ void require_valid_input(const PdsOcp& ocp, const OcpOptions& options) {
 }
 
 }  // namespace fesd::ocp_detail
+
+namespace fesd {
+
+std::vector<std::string> warnings(const Ocp& ocp) {
+  const Pss& m = ocp.model;
+  const int c = ocp.clock_state;
+  // (Models with algebraic variables z: their fields read z, which has no value here.)
+  if (!ocp.time_freezing || c < 0 || c >= m.n_x() || m.n_z() > 0 || ocp.x0.size() != m.n_x())
+    return {};
+  if (ocp.N_stages < 1) return {};
+  const Eigen::VectorXd p = ocp_detail::stage_parameters(ocp, m.p_default).front();
+  // The first interval's control guess, inside the control bounds (where IPOPT moves it).
+  Eigen::VectorXd u = ocp_detail::control_guess(ocp, 0, m.n_u());
+  if (p.size() != m.n_p() || u.size() != m.n_u()) return {};
+  for (Eigen::Index i = 0; i < u.size(); ++i) {
+    if (i < ocp.lbu.size()) u[i] = std::max(u[i], ocp.lbu[i]);
+    if (i < ocp.ubu.size()) u[i] = std::min(u[i], ocp.ubu[i]);
+  }
+  // The clock's rate in every region of every subsystem: if it differs between two regions of
+  // one subsystem, that subsystem's theta changes it (freezes it, as time freezing means to).
+  Eigen::VectorXd f(m.n_x());
+  double rate = 0;
+  for (int k = 0; k < m.n_sys(); ++k) {
+    const int first = m.region_offset(k), n_f = m.dims().subsystems[k].n_f();
+    double first_rate = 0;
+    for (int r = first; r < first + n_f; ++r) {
+      m.functions().f(r, ocp.x0.data(), u.data(), p.data(), f.data());
+      if (!std::isfinite(f[c])) return {};
+      if (r == first)
+        first_rate = f[c];
+      else if (std::abs(f[c] - first_rate) > 1e-12 * std::max(1.0, std::abs(first_rate)))
+        return {};
+    }
+    rate += first_rate;
+  }
+  const std::string name =
+      c < static_cast<int>(m.state_names.size()) ? m.state_names[c] : fmt::format("x{}", c + 1);
+  return {fmt::format(
+      "time_freezing: the clock state {} has the same rate ({:g} at x0 and the first control "
+      "guess within its bounds) in every region, so no region freezes it; the clock constraints "
+      "then fix that rate "
+      "on every control interval, which can leave the NLP without interior (nosnoc_py's discs, "
+      "docs/nosnoc-examples.md row 22)",
+      name, rate)};
+}
+
+}  // namespace fesd

@@ -367,6 +367,24 @@ TEST(NosnocFiles, ElasticBallFromTheConstantGuessStallsAndRestartsOnce) {
   EXPECT_TRUE(warned);
 }
 
+// fesd::warnings(Ocp): time freezing whose clock has the same rate in every region. The discs
+// (row 22) write t' = sot in the contact region too, so no region freezes the clock; every other
+// time-freezing file freezes it in its auxiliary regions (the temperature control only where its
+// speed-of-time control is inside its bounds: at the zero guess every rate is 0).
+TEST(NosnocFiles, TimeFreezingWarnsWhereNoRegionFreezesTheClock) {
+  const fesd::OcpProblem discs = fesd::load_ocp_problem(example_path("disc_switch_places.toml"));
+  const std::vector<std::string> w = fesd::warnings(discs.ocp);
+  ASSERT_EQ(w.size(), 1u);
+  EXPECT_NE(w[0].find("clock state t has the same rate (1 at x0"), std::string::npos) << w[0];
+  for (const char* file :
+       {"elastic_ball_in_box.toml", "hopper_ocp.toml", "hopper_ocp_step.toml", "particle.toml",
+        "temperature_control_ocp.toml", "hopper_exercise_ocp_step.toml"}) {
+    const fesd::OcpProblem p = fesd::load_ocp_problem(example_path(file));
+    ASSERT_TRUE(p.ocp.time_freezing) << file;
+    EXPECT_TRUE(fesd::warnings(p.ocp).empty()) << file;
+  }
+}
+
 // The status of a homotopy whose last NLP is followed by a failed re-solve with the active sets
 // fixed (active_set_sigma): that re-solve is discarded, so the result is the last NLP's, with its
 // residual. (It used to report success: the discarded point's residual, 0 by construction, was
