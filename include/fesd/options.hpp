@@ -190,7 +190,8 @@ struct HomotopyOptions {
   /// an NLP that failed at a point violating the constraints with no retry left
   /// (homotopy_retries), starts again once at that NLP's sigma (the schedule's) from the initial
   /// guess instead of the NLP before it, and goes on from there. Every homotopy that does not end
-  /// failed is unchanged (a failure it recovers from on the way included). In the penalty modes
+  /// failed or stalled is unchanged (a failure it recovers from on the way included). In the
+  /// penalty modes
   /// (ell_1_penalty, elastic_*) also after a stall: a converged NLP whose complementarity residual
   /// stayed above half that of its start although sigma fell (HomotopyRow::stalled), when the
   /// homotopy would end with the residual still there (docs/formulation.md, "A stalled

@@ -56,7 +56,7 @@ struct HomotopyRow {
   /// where the cold restart starts if the homotopy ends with the residual still there.
   bool stalled = false;
   /// The NLP started from the initial guess instead of the NLP before it: the cold restart, at
-  /// the sigma of the first `restarted` row.
+  /// the schedule's sigma the first `restarted` row was heading to.
   bool cold_start = false;
 };
 

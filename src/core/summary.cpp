@@ -32,7 +32,7 @@ std::string format_homotopy_row(const HomotopyRow& r) {
                : std::string("  (the last NLP again, active set fixed)");
   if (r.retried) row += "  (failed: retried from the last converged NLP, smaller sigma step)";
   if (r.stalled) row += "  (residual stalled: a stationary point of the penalty)";
-  if (r.restarted) row += "  (failed path: replaced by the cold restart)";
+  if (r.restarted) row += "  (path replaced by the cold restart)";
   // (The live table has printed the replaced rows before the restart was known: this row says
   // which they are.)
   if (r.cold_start)

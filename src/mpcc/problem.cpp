@@ -101,22 +101,26 @@ void append(HomotopyResult& to, const HomotopyResult& from) {
 }
 
 std::string cold_restart_warning(const HomotopyResult& h) {
-  bool stalled = false;
+  // The first replaced row says why: an NLP that failed, or one whose penalty stalled.
+  const HomotopyRow* first = nullptr;
   for (const HomotopyRow& r : h.rows) {
-    if (r.restarted && r.stalled) stalled = true;
+    if (r.restarted && first == nullptr) first = &r;
     if (!r.cold_start) continue;
     const std::string why =
-        stalled ? fmt::format(
-                      "the homotopy ended with the complementarity residual stalled since the NLP "
-                      "at sigma = {:.3g} (a stationary point of the penalty)",
-                      r.sigma)
-                : fmt::format(
-                      "the homotopy ended failed after the NLP at sigma = {:.3g} had failed "
-                      "(after the retries)",
-                      r.sigma);
-    return why +
-           ", so it started again there from the initial guess (homotopy_cold_restart): the "
-           "result is the minimizer that start leads to, not a continuation of the first NLPs";
+        first != nullptr && first->stalled
+            ? fmt::format(
+                  "the homotopy ended with the complementarity residual stalled since the NLP at "
+                  "sigma = {:.3g} (a stationary point of the penalty)",
+                  first->sigma)
+            : fmt::format(
+                  "the homotopy ended failed after the NLP at sigma = {:.3g} had failed (after the "
+                  "retries)",
+                  first != nullptr ? first->sigma : r.sigma);
+    return why + fmt::format(
+                     ", so it started again at sigma = {:.3g} from the initial guess "
+                     "(homotopy_cold_restart): the result is the minimizer that start leads to, "
+                     "not a continuation of the first NLPs",
+                     r.sigma);
   }
   return {};
 }
@@ -203,18 +207,19 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
   // half the logarithmic step to it when it lies above the failed sigma, so no sigma is tried
   // twice from one point.
   double sigma_retried = 0;
-  // homotopy_cold_restart: the first NLP that failed at a point violating the constraints with
-  // no retry left, or (penalty modes) whose residual stalled (its row, the schedule's sigma it was
-  // heading to, the NLPs counted then, and the stalled residual, else 0); if the homotopy ends
-  // with a failed NLP, or with the residual still stalled, it starts again there from the initial
-  // guess, once.
+  // homotopy_cold_restart: where the homotopy starts again from the initial guess, once, if it
+  // ends failed or stalled. `failed_at`: the first NLP that failed at a point violating the
+  // constraints with no retry left; `stalled_at` (penalty modes): the first NLP whose residual
+  // stalled. Each keeps its row, the schedule's sigma it was heading to, the NLPs counted then and
+  // whether it was the tight re-solve; `stalled_at` also the stalled residual.
   struct ColdStart {
     int row = -1;
     double sigma = 0;
     int scheduled = 0;
+    bool tight = false;
     double stalled_residual = 0;
   };
-  std::optional<ColdStart> cold;
+  std::optional<ColdStart> failed_at, stalled_at;
   const bool penalty = penalty_mode(relaxation_->mode());
   // The complementarity residual and sigma of the point the next NLP starts from (residual < 0:
   // the initial guess), and those of `good`.
@@ -285,16 +290,16 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
         continue;
       }
       // No retry left (or none possible): the homotopy goes on from the failed point, and where
-      // the cold restart would start if it ends failed (the first such NLP: `cold` stays set
-      // after the restart too).
-      if (!last_ok && unusable(r) && k > 0 && !cold) cold = ColdStart{k, target, scheduled};
+      // the cold restart would start if it ends failed (the first such NLP).
+      if (!last_ok && unusable(r) && k > 0 && !failed_at && !cold_restarted)
+        failed_at = ColdStart{k, target, scheduled, tight_now};
       // A stalled penalty: the NLP converged, sigma fell (its weight 1 / sigma grew), and the
       // residual did not fall to half that of its start: the point is a stationary point of the
       // penalty, and the NLPs after it usually end there too (docs/formulation.md).
-      if (last_ok && penalty && !cold && start_residual > 0 && sigma < start_sigma &&
-          res.comp_residual > o.complementarity_tol &&
+      if (last_ok && penalty && !stalled_at && !cold_restarted && start_residual > 0 &&
+          sigma < start_sigma && res.comp_residual > o.complementarity_tol &&
           res.comp_residual > kStallRatio * start_residual) {
-        cold = ColdStart{k, target, scheduled, res.comp_residual};
+        stalled_at = ColdStart{k, target, scheduled, tight_now, res.comp_residual};
         res.rows.back().stalled = true;
       }
       start_residual = res.comp_residual;
@@ -329,13 +334,15 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
     // homotopy_cold_restart: a homotopy that would end with a failed NLP, after one that failed at
     // a point violating the constraints with no retry left, solves that NLP's sigma again from the
     // initial guess (without multipliers: IPOPT's cold start) and goes on from there, once. The
-    // rows from that failure on are marked `restarted`. The same after a stalled penalty, when
-    // the homotopy would end failed or with the residual above complementarity_tol and still
-    // above half the stalled one.
-    const bool still_stalled = cold && cold->stalled_residual > 0 &&
-                               res.comp_residual > o.complementarity_tol &&
-                               res.comp_residual > kStallRatio * cold->stalled_residual;
-    if ((!last_ok || still_stalled) && cold && o.homotopy_cold_restart && !cold_restarted) {
+    // rows from that failure on are marked `restarted`. The same from a stalled penalty's NLP when
+    // the homotopy would end failed without such a failure, or with the residual above
+    // complementarity_tol and still above half the stalled one.
+    const bool still_stalled = stalled_at && res.comp_residual > o.complementarity_tol &&
+                               res.comp_residual > kStallRatio * stalled_at->stalled_residual;
+    const std::optional<ColdStart> cold = !last_ok && failed_at       ? failed_at
+                                          : !last_ok || still_stalled ? stalled_at
+                                                                      : std::nullopt;
+    if (cold && o.homotopy_cold_restart && !cold_restarted) {
       for (std::size_t i = static_cast<std::size_t>(cold->row); i < res.rows.size(); ++i)
         res.rows[i].restarted = true;
       cold_restarted = cold_now = true;
@@ -345,7 +352,7 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
       start_residual = -1;
       sigma = target = cold->sigma;
       scheduled = cold->scheduled;
-      tight_now = false;
+      tight_now = cold->tight;
       continue;
     }
     break;

@@ -391,7 +391,8 @@ TEST(NosnocFiles, TimeFreezingWarnsWhereNoRegionFreezesTheClock) {
 // taken.) The ball of the test above from the constant guess, with the homotopy cut at 5 NLPs.
 TEST(NosnocFiles, FailedFixedActiveSetResolveKeepsTheResidual) {
   fesd::OcpProblem p = uncontrolled_ball("N_homotopy", "5");
-  p.options.homotopy.homotopy_cold_restart = false;  // (the stall's restart would solve it)
+  // (The stall's cold restart would append its own rows after the discarded re-solve.)
+  p.options.homotopy.homotopy_cold_restart = false;
   const fesd::OcpResult r = fesd::solve(p.ocp, p.options);
   ASSERT_GE(r.homotopy.size(), 6u);
   EXPECT_TRUE(r.homotopy.back().active_set_fixed);

@@ -221,7 +221,13 @@ TEST(HomotopyRowText, MarksTheColdRestart) {
   cold.cold_start = true;
   fesd::HomotopyRow plain;
   plain.nlp_status = "Solve_Succeeded";
-  EXPECT_NE(fesd::format_homotopy_row(failed).find("failed path: replaced by the cold restart"),
+  EXPECT_NE(fesd::format_homotopy_row(failed).find("path replaced by the cold restart"),
+            std::string::npos);
+  fesd::HomotopyRow stalled = cold;
+  stalled.cold_start = false;
+  stalled.stalled = true;
+  EXPECT_NE(fesd::format_homotopy_row(stalled).find(
+                "residual stalled: a stationary point of the penalty"),
             std::string::npos);
   // (The live table printed the replaced rows before the restart: the cold row says which.)
   EXPECT_NE(fesd::format_homotopy_row(cold).find(
@@ -230,4 +236,5 @@ TEST(HomotopyRowText, MarksTheColdRestart) {
   const std::string p = fesd::format_homotopy_row(plain);
   EXPECT_EQ(p.find("initial guess"), std::string::npos);
   EXPECT_EQ(p.find("retried"), std::string::npos);
+  EXPECT_EQ(p.find("stalled"), std::string::npos);
 }

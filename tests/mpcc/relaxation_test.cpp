@@ -669,34 +669,44 @@ TEST(HomotopyColdRestart, AfterTheRetriesAtTheSchedulesSigmaOnce) {
   EXPECT_NEAR(res_all.rows[1].sigma, 0.01, 1e-17);
 }
 
-// An NLP solver that reports given calls as converged (Solve_Succeeded) at a given point (x, y)
-// of TinyProblem, and solves the others: a penalty NLP that ends at a stationary point of its
-// penalty, with the complementarity residual x y.
+/// What a scripted call of StallingSolver returns: the point (x, y), and converged or failed.
+struct Step {
+  double x = 0, y = 0;
+  bool ok = true;     ///< Solve_Succeeded; else a failure with inf_pr
+  double inf_pr = 0;  ///< 1: a point violating the constraints
+};
+
+// An NLP solver that reports given calls as converged (Solve_Succeeded) or failed at a given point
+// (x, y) of TinyProblem, and solves the others: a penalty NLP that ends at a stationary point of
+// its penalty has the complementarity residual x y.
 class StallingSolver : public fesd::nlp::NlpSolver {
  public:
-  StallingSolver(int x, int y, std::map<int, std::pair<double, double>> points)
-      : x_(x), y_(y), points_(std::move(points)) {}
+  StallingSolver(int x, int y, std::map<int, Step> steps)
+      : x_(x), y_(y), steps_(std::move(steps)) {}
   fesd::nlp::NlpResult solve(const fesd::nlp::BlockNlp& nlp, fesd::nlp::Iterate& start,
                              bool warm_start, double tol, int max_iter,
                              const fesd::nlp::CallerHandles& caller_handles) override {
     starts.push_back(start.x);
     warm.push_back(warm_start);
-    const auto it = points_.find(calls_++);
-    if (it == points_.end())
+    tols.push_back(tol);
+    const auto it = steps_.find(calls_++);
+    if (it == steps_.end())
       return inner_->solve(nlp, start, warm_start, tol, max_iter, caller_handles);
-    start.x[x_] = it->second.first;
-    start.x[y_] = it->second.second;
+    start.x[x_] = it->second.x;
+    start.x[y_] = it->second.y;
     fesd::nlp::NlpResult r;
-    r.success = true;
-    r.status = "Solve_Succeeded";
+    r.success = it->second.ok;
+    r.inf_pr = it->second.inf_pr;
+    r.status = r.success ? "Solve_Succeeded" : "Infeasible_Problem_Detected";
     return r;
   }
   std::vector<std::vector<double>> starts;  ///< the primal start of every call
   std::vector<bool> warm;                   ///< warm_start of every call
+  std::vector<double> tols;                 ///< tol of every call (0: the configured one)
 
  private:
   int x_, y_;
-  std::map<int, std::pair<double, double>> points_;
+  std::map<int, Step> steps_;
   int calls_ = 0;
   std::unique_ptr<fesd::nlp::NlpSolver> inner_ = fesd::nlp::make_solver(fesd::NlpOptions{});
 };
@@ -710,7 +720,7 @@ class StallingSolver : public fesd::nlp::NlpSolver {
 TEST(HomotopyColdRestart, StalledPenaltyStartsAgainFromTheInitialGuess) {
   fesd::HomotopyOptions options = homotopy_down_to(1e-4, 0);
   TinyProblem p(1.0, MpccMode::ElasticIneq);
-  const std::pair<double, double> stuck{0.5, 0.42};
+  const Step stuck{0.5, 0.42};
   StallingSolver solver(p.x, p.y, {{0, {0.5, 0.8}}, {1, stuck}, {2, stuck}, {3, stuck}});
   const auto res = p.problem.solve_homotopy(solver, options);
   ASSERT_EQ(res.status, fesd::Status::Success) << res.last_nlp_status;
@@ -749,7 +759,7 @@ TEST(HomotopyColdRestart, StalledPenaltyStartsAgainFromTheInitialGuess) {
 // recovers from (the next NLP solves) changes nothing.
 TEST(HomotopyColdRestart, StallIsAResidualAboveHalfItsStart) {
   const fesd::HomotopyOptions options = homotopy_down_to(1e-4, 0);
-  const std::map<int, std::pair<double, double>> points{
+  const std::map<int, Step> points{
       {0, {0.5, 0.8}}, {1, {0.5, 0.38}}, {2, {0.5, 0.36}}, {3, {0.5, 0.36}}};
   TinyProblem p(1.0, MpccMode::ElasticIneq);
   StallingSolver solver(p.x, p.y, points);
@@ -773,6 +783,102 @@ TEST(HomotopyColdRestart, StallIsAResidualAboveHalfItsStart) {
   ASSERT_EQ(res_q.status, fesd::Status::Success) << res_q.last_nlp_status;
   EXPECT_TRUE(res_q.rows[1].stalled);
   for (const fesd::HomotopyRow& r : res_q.rows) EXPECT_FALSE(r.cold_start || r.restarted);
+}
+
+// The stall and the failure rungs together (elastic_ineq, retries 0 unless said; the first NLP
+// ends with the residual 0.4, "stuck" converges with 0.21, "infeasible" fails at inf_pr 1):
+// a) a stall followed by a failed last NLP (feasible: no failure rung) restarts at the stall;
+// b) an infeasible failure the path goes on from, then a stall to the end: restarts at the stall
+//    (each rung keeps its own first NLP);
+// c) a stall, then infeasible failures to the end: restarts at the failure, as without the stall;
+// d) a stall on a retry's smaller step (retries 4): restarts at the schedule's sigma it was
+//    heading to, and the warning names both sigmas;
+// e) a stall that partly recovers (ends above complementarity_tol but below half the stalled
+//    residual): no restart.
+TEST(HomotopyColdRestart, StallAndFailureKeepTheirOwnRestartPoints) {
+  const Step first{0.5, 0.8}, stuck{0.5, 0.42}, infeasible{5.0, 5.0, false, 1.0};
+  const auto run = [](std::map<int, Step> steps, int retries, double sigma_N = 1e-4) {
+    auto p = std::make_unique<TinyProblem>(1.0, MpccMode::ElasticIneq);
+    StallingSolver solver(p->x, p->y, std::move(steps));
+    auto res = p->problem.solve_homotopy(solver, homotopy_down_to(sigma_N, retries));
+    return std::pair{std::move(res), std::move(solver)};
+  };
+  const auto cold_row = [](const fesd::mpcc::HomotopyResult& res) {
+    for (std::size_t k = 0; k < res.rows.size(); ++k)
+      if (res.rows[k].cold_start) return static_cast<int>(k);
+    return -1;
+  };
+  {  // a)
+    const auto [res, solver] =
+        run({{0, first}, {1, stuck}, {2, stuck}, {3, {0.5, 0.42, false, 1e-9}}}, 0);
+    ASSERT_EQ(cold_row(res), 4);
+    EXPECT_NEAR(res.rows[4].sigma, 0.01, 1e-17);
+    EXPECT_TRUE(res.rows[1].restarted);
+    EXPECT_EQ(res.status, fesd::Status::Success);
+  }
+  {  // b)
+    const auto [res, solver] =
+        run({{0, first}, {1, infeasible}, {2, stuck}, {3, stuck}, {4, stuck}}, 0, 1e-5);
+    EXPECT_FALSE(res.rows[1].stalled);  // (its start is the failed point: 25)
+    EXPECT_TRUE(res.rows[3].stalled);   // 0.21 after 0.21 at sigma = 1e-4
+    ASSERT_EQ(cold_row(res), 5);
+    EXPECT_NEAR(res.rows[5].sigma, 1e-4, 1e-19);
+    EXPECT_FALSE(res.rows[2].restarted);
+    EXPECT_TRUE(res.rows[3].restarted);
+    EXPECT_NE(fesd::mpcc::cold_restart_warning(res).find("stalled since the NLP at sigma = 0.0001"),
+              std::string::npos);
+  }
+  {  // c)
+    const auto [res, solver] = run({{0, first}, {1, stuck}, {2, infeasible}, {3, infeasible}}, 0);
+    EXPECT_TRUE(res.rows[1].stalled);
+    ASSERT_EQ(cold_row(res), 4);
+    EXPECT_NEAR(res.rows[4].sigma, 1e-3, 1e-18);
+    EXPECT_FALSE(res.rows[1].restarted);
+    EXPECT_NE(fesd::mpcc::cold_restart_warning(res).find("had failed"), std::string::npos);
+    EXPECT_EQ(res.status, fesd::Status::Success);
+  }
+  {  // d) 0.01 fails; the retry at 10^-1.5 stalls (0.21 after 0.4 from the point of 0.1)
+    const auto [res, solver] =
+        run({{0, first}, {1, infeasible}, {2, stuck}, {3, stuck}, {4, stuck}, {5, stuck}}, 4);
+    ASSERT_TRUE(res.rows[1].retried);
+    EXPECT_NEAR(res.rows[2].sigma, std::pow(10.0, -1.5), 1e-17);
+    EXPECT_TRUE(res.rows[2].stalled);
+    const int c = cold_row(res);
+    ASSERT_GT(c, 2);
+    EXPECT_NEAR(res.rows[static_cast<std::size_t>(c)].sigma, 0.01, 1e-17);
+    const std::string w = fesd::mpcc::cold_restart_warning(res);
+    EXPECT_NE(w.find("stalled since the NLP at sigma = 0.0316"), std::string::npos) << w;
+    EXPECT_NE(w.find("started again at sigma = 0.01"), std::string::npos) << w;
+  }
+  {  // e)
+    const auto [res, solver] = run({{0, first}, {1, stuck}, {2, {0.5, 0.1}}, {3, {0.5, 0.1}}}, 0);
+    EXPECT_TRUE(res.rows[1].stalled);
+    EXPECT_EQ(cold_row(res), -1);
+    EXPECT_EQ(res.status, fesd::Status::ComplementarityNotMet);
+  }
+}
+
+// A failure of the tight re-solve of the schedule's last NLP (Scholtes, 2 NLPs, intermediate_tol:
+// sigma = 0.01 meets complementarity_tol loosely and is solved again tight, which fails
+// infeasible): the cold restart solves that tight NLP again from the initial guess. (It used to
+// run no NLP: the schedule was already counted without the tight re-solve.)
+TEST(HomotopyColdRestart, RestartOfTheTightResolveSolvesIt) {
+  fesd::HomotopyOptions o = homotopy_down_to(1e-4, 0);
+  o.max_homotopy_steps = 2;
+  o.intermediate_tol = 1e-6;
+  TinyProblem p(1.0);
+  StallingSolver solver(p.x, p.y, {{0, {0.5, 0.8}}, {1, {1.0, 0.0}}, {2, {5.0, 5.0, false, 1.0}}});
+  const auto res = p.problem.solve_homotopy(solver, o);
+  ASSERT_EQ(res.rows.size(), 4u);
+  EXPECT_EQ(res.rows[2].sigma, res.rows[1].sigma);  // the tight re-solve
+  EXPECT_TRUE(res.rows[2].restarted);
+  EXPECT_TRUE(res.rows[3].cold_start);
+  EXPECT_EQ(res.rows[3].sigma, res.rows[1].sigma);
+  EXPECT_EQ(solver.tols[1], 1e-6);
+  EXPECT_EQ(solver.tols[3], 0.0);  // tight, as the NLP it replaces
+  EXPECT_EQ(res.rows[3].nlp_status, "Solve_Succeeded");
+  // (That point is the relaxed one of sigma = 0.01, the schedule's last: residual 0.01.)
+  EXPECT_EQ(res.status, fesd::Status::ComplementarityNotMet);
 }
 
 // ---- Example 3(a) through the integrator ------------------------------------------------------
