@@ -28,12 +28,6 @@ bool unusable(const nlp::NlpResult& r) {
   return r.eval_error || !(r.inf_pr <= kFeasibleFailure);
 }
 
-// The penalty modes: sigma weighs a penalty term (1 / sigma) P instead of bounding each product,
-// so the complementarity residual is not held below sigma and can stall (homotopy_cold_restart).
-bool penalty_mode(MpccMode m) {
-  return m == MpccMode::ElasticIneq || m == MpccMode::ElasticTwoSided || m == MpccMode::L1Penalty;
-}
-
 // A converged NLP of a penalty mode whose complementarity residual is more than this fraction of
 // the residual of the point it started from, although sigma fell, has stalled: its point is a
 // stationary point of the penalty (docs/formulation.md, "A stalled penalty").
@@ -220,7 +214,9 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
     double stalled_residual = 0;
   };
   std::optional<ColdStart> failed_at, stalled_at;
-  const bool penalty = penalty_mode(relaxation_->mode());
+  // The penalty modes: sigma weighs a penalty term (1 / sigma) P instead of bounding each
+  // product, so the complementarity residual is not held below sigma and can stall.
+  const bool penalty = penalizes(relaxation_->mode());
   // The complementarity residual and sigma of the point the next NLP starts from (residual < 0:
   // the initial guess), and those of `good`.
   double start_residual = -1, start_sigma = 0, good_residual = -1;
