@@ -392,9 +392,8 @@ std::vector<std::string> warnings(const Ocp& ocp) {
   return {fmt::format(
       "time_freezing: the clock state {} has the same rate ({:g} at x0 and the first control "
       "guess within its bounds) in every region, so no region freezes it; the clock constraints "
-      "then fix that rate "
-      "on every control interval, which can leave the NLP without interior (nosnoc_py's discs, "
-      "docs/nosnoc-examples.md row 22)",
+      "then fix that rate on every control interval, which can leave the NLP without interior "
+      "(nosnoc_py's discs, docs/nosnoc-examples.md row 22)",
       name, rate)};
 }
 
