@@ -191,15 +191,14 @@ struct HomotopyOptions {
   /// (homotopy_retries), starts again once at that NLP's sigma (the schedule's) from the initial
   /// guess instead of the NLP before it, and goes on from there. Every homotopy that does not end
   /// failed or stalled is unchanged (a failure it recovers from on the way included). In the
-  /// penalty modes
-  /// (ell_1_penalty, elastic_*) also after a stall: a converged NLP whose complementarity residual
-  /// stayed above half that of its start although sigma fell (HomotopyRow::stalled), when the
-  /// homotopy would end with the residual still there (docs/formulation.md, "A stalled
-  /// penalty": nosnoc_py's elastic ball in a box). The relaxed path of a
-  /// loose first sigma can end where the tighter NLPs have no feasible neighbour (nosnoc_py's
-  /// temperature control and 3-D gearbox, docs/nosnoc-examples.md rows 9 and 32); the cold start
-  /// reaches the NLP's feasible set from elsewhere, usually at another local minimizer (the
-  /// summary says so). The rows of the replaced path are marked `restarted`, the cold NLP
+  /// penalty modes (ell_1_penalty, elastic_*) also after a stall: a converged NLP whose
+  /// complementarity residual stayed above half that of its start although sigma fell
+  /// (HomotopyRow::stalled), when the homotopy would end with the residual still there
+  /// (docs/formulation.md, "A stalled penalty": nosnoc_py's elastic ball in a box). The relaxed
+  /// path of a loose first sigma can end where the tighter NLPs have no feasible neighbour
+  /// (nosnoc_py's temperature control and 3-D gearbox, docs/nosnoc-examples.md rows 9 and 32); the
+  /// cold start reaches the NLP's feasible set from elsewhere, usually at another local minimizer
+  /// (the summary says so). The rows of the replaced path are marked `restarted`, the cold NLP
   /// `cold_start`.
   bool homotopy_cold_restart = true;
   /// `intermediate_tol` >= 0: IPOPT tol of the NLPs with sigma > 10 complementarity_tol (they

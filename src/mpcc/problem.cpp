@@ -205,13 +205,12 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
   // ends failed or stalled. `failed_at`: the first NLP that failed at a point violating the
   // constraints with no retry left; `stalled_at` (penalty modes): the first NLP whose residual
   // stalled. Each keeps its row, the schedule's sigma it was heading to, the NLPs counted then and
-  // whether it was the tight re-solve; `stalled_at` also the stalled residual.
+  // whether it was the tight re-solve.
   struct ColdStart {
     int row = -1;
     double sigma = 0;
     int scheduled = 0;
     bool tight = false;
-    double stalled_residual = 0;
   };
   std::optional<ColdStart> failed_at, stalled_at;
   // The penalty modes: sigma weighs a penalty term (1 / sigma) P instead of bounding each
@@ -295,7 +294,7 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
       if (last_ok && penalty && !stalled_at && !cold_restarted && start_residual > 0 &&
           sigma < start_sigma && res.comp_residual > o.complementarity_tol &&
           res.comp_residual > kStallRatio * start_residual) {
-        stalled_at = ColdStart{k, target, scheduled, tight_now, res.comp_residual};
+        stalled_at = ColdStart{k, target, scheduled, tight_now};
         res.rows.back().stalled = true;
       }
       start_residual = res.comp_residual;
@@ -333,8 +332,10 @@ HomotopyResult Problem::solve_homotopy(nlp::NlpSolver& solver, const HomotopyOpt
     // rows from that failure on are marked `restarted`. The same from a stalled penalty's NLP when
     // the homotopy would end failed without such a failure, or with the residual above
     // complementarity_tol and still above half the stalled one.
-    const bool still_stalled = stalled_at && res.comp_residual > o.complementarity_tol &&
-                               res.comp_residual > kStallRatio * stalled_at->stalled_residual;
+    const bool still_stalled =
+        stalled_at && res.comp_residual > o.complementarity_tol &&
+        res.comp_residual >
+            kStallRatio * res.rows[static_cast<std::size_t>(stalled_at->row)].comp_residual;
     const std::optional<ColdStart> cold = !last_ok && failed_at       ? failed_at
                                           : !last_ok || still_stalled ? stalled_at
                                                                       : std::nullopt;
